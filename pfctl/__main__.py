@@ -1,0 +1,3 @@
+from pfctl.cli import main
+
+main()

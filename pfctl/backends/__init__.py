@@ -1,0 +1,1 @@
+"""Robot-port implementations: the simulated house and the real HSR (later issues)."""

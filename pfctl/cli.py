@@ -1,0 +1,53 @@
+"""The `pfctl` command line: registers the command groups and turns user errors into exit 2."""
+
+from __future__ import annotations
+
+import sys
+
+import typer
+
+from pfctl import __version__
+from pfctl.commands import map as map_commands
+from pfctl.commands import mission as mission_commands
+from pfctl.errors import UserError
+
+app = typer.Typer(
+    name="pfctl",
+    help="Person-following with active target search: learn a person, follow them, find them again.",
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    add_completion=False,
+)
+app.add_typer(mission_commands.app, name="mission")
+app.add_typer(map_commands.app, name="map")
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"pfctl {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
+    """Person-following with active target search."""
+
+
+def main() -> None:
+    """Console entry point: user errors become one line on stderr and exit status 2."""
+    try:
+        app()
+    except UserError as err:
+        sys.stderr.write(f"pfctl: error: {err}\n")
+        sys.exit(err.exit_code)
+    except KeyboardInterrupt:
+        sys.stderr.write("pfctl: interrupted\n")
+        sys.exit(130)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()

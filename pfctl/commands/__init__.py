@@ -1,0 +1,1 @@
+"""One module per CLI command group: parse, load the mission, call core/backends, report."""
