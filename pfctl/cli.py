@@ -13,7 +13,9 @@ from pfctl.errors import UserError
 
 app = typer.Typer(
     name="pfctl",
-    help="Person-following with active target search: learn a person, follow them, find them again.",
+    help=(
+        "Person-following with active target search: learn a person, follow them, find them again."
+    ),
     no_args_is_help=True,
     pretty_exceptions_enable=False,
     add_completion=False,

@@ -4,18 +4,52 @@ Layout: ``logodds`` has shape ``(height, width)``; row ``r`` is the y index and 
 index, so cell ``(r, c)`` covers ``[ox + c·res, ox + (c+1)·res) × [oy + r·res, oy + (r+1)·res)`` in
 the map frame (REP-103: x forward, y left), with ``(ox, oy) = origin`` the lower-left corner of cell
 ``(0, 0)`` — the same convention as nav_msgs/OccupancyGrid (row-major, first row at the origin).
+
+The grid keeps the log-odds ``l = log(p / (1 − p))`` of each cell; the prior p(m) = 0.5 is l = 0.
+Laser scans are fused with the binary Bayes filter of Eq. 1 through an inverse sensor model
+(:class:`InverseSensorModel`, :meth:`OccupancyGrid.update_scan`), and the map's uncertainty is its
+entropy H(M) (:meth:`OccupancyGrid.entropy`, §II-C). Grids are read and written in the ROS
+map_server format (YAML + PGM) and converted to and from nav_msgs/OccupancyGrid data.
 """
 
 from __future__ import annotations
 
+import contextlib
+import math
+import os
+import tempfile
+from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
 import numpy as np
+import yaml
 from numpy.typing import ArrayLike, NDArray
+from scipy.special import entr
 
 FREE = 0
 OCCUPIED = 1
 UNKNOWN = -1
+
+#: Default trinary thresholds of ROS map_server / map_saver: p < FREE_THRESH is free,
+#: p > OCCUPIED_THRESH is occupied, anything in between is unknown.
+FREE_THRESH = 0.196
+OCCUPIED_THRESH = 0.65
+
+#: Probabilities 0 and 1 (a map file's "certainly free / occupied") are stored as
+#: p = SATURATION and 1 − SATURATION, i.e. log-odds ±SATURATION_LOGODDS (≈ ±20.7), so the
+#: log-odds stay finite. A later scan update clamps such a cell to the sensor model's bounds.
+SATURATION = 1e-9
+SATURATION_LOGODDS = math.log((1.0 - SATURATION) / SATURATION)
+
+#: Pixel values written by map_saver in trinary mode.
+PGM_FREE = 254
+PGM_OCCUPIED = 0
+PGM_UNKNOWN = 205
+
+_MAP_MODES = ("trinary", "scale", "raw")
+_EDGE = 1e-6  # beams are clipped to the grid shrunk by this many cells, so floor() stays inside
 
 
 def logit(p: ArrayLike) -> NDArray[np.float64]:
@@ -24,9 +58,22 @@ def logit(p: ArrayLike) -> NDArray[np.float64]:
     return np.log(p / (1.0 - p))
 
 
-def inv_logit(l: ArrayLike) -> NDArray[np.float64]:
-    """The probability of a log-odds value: 1 / (1 + exp(−l))."""
-    return 1.0 / (1.0 + np.exp(-np.asarray(l, dtype=float)))
+def inv_logit(log_odds: ArrayLike) -> NDArray[np.float64]:
+    """The probability of a log-odds value l: 1 / (1 + exp(−l))."""
+    return 1.0 / (1.0 + np.exp(-np.asarray(log_odds, dtype=float)))
+
+
+def _saturated_logit(p: ArrayLike) -> NDArray[np.float64]:
+    """logit(p) with p clipped to [SATURATION, 1 − SATURATION], so 0 and 1 stay finite."""
+    return logit(np.clip(np.asarray(p, dtype=float), SATURATION, 1.0 - SATURATION))
+
+
+class GridFileError(ValueError):
+    """A map file (map_server YAML or PGM) that cannot be read or written.
+
+    The message is one line that names the file and says what is wrong; the CLI turns it into
+    exit status 2 (DESIGN.md, "Conventions").
+    """
 
 
 @dataclass(frozen=True)
@@ -39,7 +86,7 @@ class GridGeometry:
     origin: tuple[float, float] = (0.0, 0.0)
 
     def world_to_cell(self, xy: ArrayLike) -> tuple[NDArray[np.intp], NDArray[np.intp]]:
-        """(rows, cols) of the cells containing points ``xy`` (shape (..., 2)); may be out of bounds."""
+        """(rows, cols) of the cells containing points ``xy`` (shape (..., 2)); may be outside."""
         xy = np.asarray(xy, dtype=float)
         cols = np.floor((xy[..., 0] - self.origin[0]) / self.resolution).astype(np.intp)
         rows = np.floor((xy[..., 1] - self.origin[1]) / self.resolution).astype(np.intp)
@@ -68,3 +115,705 @@ class GridGeometry:
         """(xmin, xmax, ymin, ymax) in metres, e.g. for matplotlib's ``imshow(origin='lower')``."""
         ox, oy = self.origin
         return (ox, ox + self.width * self.resolution, oy, oy + self.height * self.resolution)
+
+
+@dataclass(frozen=True)
+class InverseSensorModel:
+    """Inverse sensor model p(m | z_t) of a laser beam, and the bounds of the Bayes filter (Eq. 1).
+
+    A cell where a beam ends (a valid return) is occupied with probability ``p_hit``; a cell a beam
+    passes through is occupied with probability ``p_miss``. These are the mission's
+    ``map.sensor_model``.
+
+    Eq. 1 of the paper is the binary Bayes filter of one cell m::
+
+        p(m | z_1:t) = [1 + (1 − p(m|z_t)) / p(m|z_t)
+                          · (1 − p(m|z_1:t−1)) / p(m|z_1:t−1)
+                          · p(m) / (1 − p(m))]^−1
+
+    which, in log-odds l = log(p / (1 − p)), is the sum
+
+        l_t = l_{t−1} + logit(p(m | z_t)) − logit(p(m)).
+
+    With the prior p(m) = 0.5 (unknown, U = 0.5) the last term is 0, so a hit adds
+    ``logit(p_hit)`` and a miss adds ``logit(p_miss)``. After each update l_t is clamped to
+    ``[logit(p_min), logit(p_max)]`` so that a cell can always change its mind again (a door opens).
+    """
+
+    p_hit: float = 0.7
+    p_miss: float = 0.4
+    p_min: float = 0.02
+    p_max: float = 0.98
+
+    def __post_init__(self) -> None:
+        for name in ("p_hit", "p_miss", "p_min", "p_max"):
+            value = getattr(self, name)
+            if not 0.0 < value < 1.0:
+                raise ValueError(f"InverseSensorModel.{name} must be in (0, 1), got {value}")
+        if not self.p_miss < 0.5 < self.p_hit:
+            raise ValueError(
+                f"InverseSensorModel needs p_miss < 0.5 < p_hit, got {self.p_miss}, {self.p_hit}"
+            )
+        if not self.p_min < 0.5 < self.p_max:
+            raise ValueError(
+                f"InverseSensorModel needs p_min < 0.5 < p_max, got {self.p_min}, {self.p_max}"
+            )
+
+    @property
+    def l_hit(self) -> float:
+        """logit(p_hit): what a hit adds to a cell's log-odds (Eq. 1)."""
+        return math.log(self.p_hit / (1.0 - self.p_hit))
+
+    @property
+    def l_miss(self) -> float:
+        """logit(p_miss): what a pass-through adds to a cell's log-odds (Eq. 1); negative."""
+        return math.log(self.p_miss / (1.0 - self.p_miss))
+
+    @property
+    def l_min(self) -> float:
+        """logit(p_min), the lower clamp of the log-odds."""
+        return math.log(self.p_min / (1.0 - self.p_min))
+
+    @property
+    def l_max(self) -> float:
+        """logit(p_max), the upper clamp of the log-odds."""
+        return math.log(self.p_max / (1.0 - self.p_max))
+
+
+class OccupancyGrid:
+    """A probabilistic occupancy grid: the log-odds of p(m) per cell, updated by Eq. 1.
+
+    ``logodds`` has shape ``(geometry.height, geometry.width)`` (see the module docstring for the
+    layout); 0 is the prior p(m) = 0.5. The constructor copies ``logodds``. ``sensor_model`` is the
+    inverse sensor model used by :meth:`update_scan` and :meth:`update_cells`.
+    """
+
+    def __init__(
+        self,
+        geometry: GridGeometry,
+        logodds: ArrayLike | None = None,
+        sensor_model: InverseSensorModel | None = None,
+    ) -> None:
+        if not (math.isfinite(geometry.resolution) and geometry.resolution > 0):
+            raise ValueError(f"grid resolution must be > 0, got {geometry.resolution}")
+        if geometry.width < 1 or geometry.height < 1:
+            raise ValueError(f"grid must have at least one cell, got {geometry.shape}")
+        self.geometry = geometry
+        if logodds is None:
+            self.logodds: NDArray[np.float64] = np.zeros(geometry.shape, dtype=np.float64)
+        else:
+            array = np.array(logodds, dtype=np.float64)
+            if array.shape != geometry.shape:
+                raise ValueError(f"logodds has shape {array.shape}, geometry says {geometry.shape}")
+            self.logodds = array
+        self.sensor_model = sensor_model if sensor_model is not None else InverseSensorModel()
+
+    # ----------------------------------------------------------------------------- construction
+
+    @classmethod
+    def empty(
+        cls,
+        width_m: float,
+        height_m: float,
+        resolution: float,
+        origin: tuple[float, float] = (0.0, 0.0),
+        sensor_model: InverseSensorModel | None = None,
+    ) -> OccupancyGrid:
+        """An all-unknown grid (p = 0.5) covering at least ``width_m × height_m`` metres."""
+        if not (resolution > 0 and width_m > 0 and height_m > 0):
+            raise ValueError(
+                f"need positive size and resolution, got {width_m} × {height_m} m at {resolution}"
+            )
+        # 1e-9 forgives float noise: 20 m / 0.05 m is 400 cells, not 401.
+        width = max(1, math.ceil(width_m / resolution - 1e-9))
+        height = max(1, math.ceil(height_m / resolution - 1e-9))
+        geometry = GridGeometry(float(resolution), width, height, _origin(origin))
+        return cls(geometry, sensor_model=sensor_model)
+
+    @classmethod
+    def from_probabilities(
+        cls,
+        p: ArrayLike,
+        resolution: float,
+        origin: tuple[float, float] = (0.0, 0.0),
+        sensor_model: InverseSensorModel | None = None,
+    ) -> OccupancyGrid:
+        """A grid with p(m) = ``p`` (shape (height, width), row 0 at the origin).
+
+        0 and 1 are stored as SATURATION and 1 − SATURATION so the log-odds stay finite.
+        """
+        p = np.asarray(p, dtype=float)
+        if p.ndim != 2 or p.size == 0:
+            raise ValueError(f"probabilities must be a non-empty 2-D array, got shape {p.shape}")
+        if not np.all((p >= 0.0) & (p <= 1.0)):
+            raise ValueError("probabilities must lie in [0, 1] (and not be NaN)")
+        geometry = GridGeometry(float(resolution), p.shape[1], p.shape[0], _origin(origin))
+        return cls(geometry, _saturated_logit(p), sensor_model)
+
+    @classmethod
+    def from_occupancy_values(
+        cls,
+        data: ArrayLike,
+        width: int,
+        height: int,
+        resolution: float,
+        origin: tuple[float, float] = (0.0, 0.0),
+        sensor_model: InverseSensorModel | None = None,
+    ) -> OccupancyGrid:
+        """A grid from nav_msgs/OccupancyGrid ``data`` (row-major, row 0 at the origin).
+
+        A value v in 0..100 becomes p = v / 100 (0 and 100 saturated, see SATURATION); −1 (and
+        any other negative value) is unknown, p = 0.5. Values above 100 raise ValueError.
+        """
+        values = np.asarray(data).astype(np.int64).ravel()
+        if values.size != width * height:
+            raise ValueError(f"{values.size} occupancy values for a {width} × {height} grid")
+        if np.any(values > 100):
+            raise ValueError(f"occupancy values must be −1 or 0..100, got {int(values.max())}")
+        p = np.where(values < 0, 0.5, values / 100.0).reshape(height, width)
+        return cls.from_probabilities(p, resolution, origin, sensor_model)
+
+    def copy(self) -> OccupancyGrid:
+        """An independent copy (the log-odds array is copied)."""
+        return OccupancyGrid(self.geometry, self.logodds, self.sensor_model)
+
+    def __repr__(self) -> str:
+        g = self.geometry
+        return (
+            f"OccupancyGrid({g.width}×{g.height} cells at {g.resolution} m, origin={g.origin}, "
+            f"{self.sensor_model})"
+        )
+
+    # ------------------------------------------------------------------------------ properties
+
+    @property
+    def resolution(self) -> float:
+        return self.geometry.resolution
+
+    @property
+    def origin(self) -> tuple[float, float]:
+        return self.geometry.origin
+
+    @property
+    def width(self) -> int:
+        return self.geometry.width
+
+    @property
+    def height(self) -> int:
+        return self.geometry.height
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.geometry.shape
+
+    def prob(self) -> NDArray[np.float64]:
+        """p(m) of every cell, shape (height, width)."""
+        return inv_logit(self.logodds)
+
+    def states(
+        self, free_thresh: float = FREE_THRESH, occupied_thresh: float = OCCUPIED_THRESH
+    ) -> NDArray[np.int8]:
+        """FREE (0) where p < free_thresh, OCCUPIED (1) where p > occupied_thresh, else UNKNOWN.
+
+        The paper's three cell values O = 1, F = 0, U = 0.5 (§II-C) are these states; the default
+        thresholds are those of ROS map_server.
+        """
+        p = self.prob()
+        out = np.full(p.shape, UNKNOWN, dtype=np.int8)
+        out[p < free_thresh] = FREE
+        out[p > occupied_thresh] = OCCUPIED
+        return out
+
+    def entropy(self, base: float = 2.0) -> float:
+        """Map entropy H(M) = −Σ_m [p log p + (1 − p) log(1 − p)] over all cells (§II-C).
+
+        0 log 0 = 0. The default base is 2, so H is in bits; pass ``base=math.e`` for nats. An
+        all-unknown grid (p = 0.5 everywhere) of N cells has H = N·log_base(2), i.e. N bits; a
+        grid whose cells are all certainly free or occupied has H ≈ 0.
+        """
+        if not (base > 0 and base != 1):
+            raise ValueError(f"entropy base must be > 0 and ≠ 1, got {base}")
+        p = self.prob()
+        return float(np.sum(entr(p) + entr(1.0 - p)) / math.log(base))
+
+    # ---------------------------------------------------------------------------------- update
+
+    def update_cells(self, hit_mask: ArrayLike, free_mask: ArrayLike) -> None:
+        """Apply one observation to each marked cell with Eq. 1, in log-odds.
+
+        Cells of ``hit_mask`` get l += logit(p_hit); cells of ``free_mask`` that are not hits get
+        l += logit(p_miss) (a cell both hit and passed through counts as hit). The prior term
+        −logit(p(m)) of Eq. 1 is 0 for p(m) = 0.5. The updated cells are then clamped to
+        [logit(p_min), logit(p_max)]; other cells are left exactly as they were.
+        """
+        hit = np.asarray(hit_mask, dtype=bool)
+        free = np.asarray(free_mask, dtype=bool)
+        if hit.shape != self.shape or free.shape != self.shape:
+            raise ValueError(f"masks must have the grid's shape {self.shape}")
+        model = self.sensor_model
+        lo = self.logodds
+        np.add(lo, model.l_miss, out=lo, where=free & ~hit)
+        np.add(lo, model.l_hit, out=lo, where=hit)
+        np.clip(lo, model.l_min, model.l_max, out=lo, where=hit | free)
+
+    def update_scan(
+        self,
+        pose: Sequence[float],
+        ranges: ArrayLike,
+        angle_min: float,
+        angle_increment: float,
+        range_max: float,
+        range_min: float = 0.0,
+        max_update_range: float | None = None,
+    ) -> None:
+        """Fuse one laser scan into the grid with the Bayes filter of Eq. 1.
+
+        ``pose`` = (x, y, θ) of the sensor in the map frame; beam k points at θ + angle_min +
+        k·angle_increment. Every cell in the field of view is updated once per scan (see
+        :meth:`scan_masks` for which cells, and :meth:`update_cells` for the update).
+        """
+        hit, free = self.scan_masks(
+            pose, ranges, angle_min, angle_increment, range_max, range_min, max_update_range
+        )
+        self.update_cells(hit, free)
+
+    def scan_masks(
+        self,
+        pose: Sequence[float],
+        ranges: ArrayLike,
+        angle_min: float,
+        angle_increment: float,
+        range_max: float,
+        range_min: float = 0.0,
+        max_update_range: float | None = None,
+    ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+        """The (hit, free) cell masks of one scan, each of shape (height, width).
+
+        Range semantics follow REP-117:
+
+        - ``range_min ≤ r ≤ range_max`` (and ``r ≤ max_update_range`` if given): a return. The
+          cell containing the end point is a hit; the cells the beam passes through up to there
+          are free; nothing beyond the hit is touched.
+        - ``+inf`` or ``r > range_max``: no return within range; the beam is free up to
+          ``range_max`` and has no hit.
+        - ``r > max_update_range``: free up to ``max_update_range``, no hit.
+        - ``−inf`` (too close), NaN (invalid) and ``r < range_min``: the beam changes nothing.
+
+        Beams are clipped to the grid; cells outside are ignored. The traversal is exact (every cell
+        the segment enters, like a DDA / Amanatides–Woo walk) and vectorised over the beams: along
+        each beam's major axis it finds the crossings of the grid lines and marks the two cells
+        either side of each crossing, plus the first and last cell.
+        """
+        x, y, theta = (float(v) for v in pose)
+        if not all(math.isfinite(v) for v in (x, y, theta, angle_min, angle_increment)):
+            raise ValueError(f"scan pose and angles must be finite, got {pose}")
+        r = np.asarray(ranges, dtype=float).ravel()
+        geometry = self.geometry
+        res = geometry.resolution
+        W, H = geometry.width, geometry.height
+        hit = np.zeros(H * W, dtype=bool)
+        free = np.zeros(H * W, dtype=bool)
+        if r.size == 0:
+            return hit.reshape(H, W), free.reshape(H, W)
+
+        reach = float(range_max)
+        if max_update_range is not None:
+            reach = min(reach, float(max_update_range))
+        with np.errstate(invalid="ignore"):
+            returned = (r >= range_min) & (r <= range_max) & (r <= reach)
+            no_return = np.isposinf(r) | (r > range_max)
+            # r beyond max_update_range but within range_max: free up to reach, no hit.
+            no_return |= (r > reach) & (r <= range_max)
+        use = returned | no_return
+        if not np.any(use) or reach <= 0:
+            return hit.reshape(H, W), free.reshape(H, W)
+        index = np.flatnonzero(use)
+        angles = theta + angle_min + index * angle_increment
+        cx = np.cos(angles)
+        cy = np.sin(angles)
+        is_hit = returned[index]
+        length = np.where(is_hit, r[index], reach) / res  # in cells
+        x0 = (x - geometry.origin[0]) / res
+        y0 = (y - geometry.origin[1]) / res
+
+        # Hits: the cell containing the end point, if it is in the grid.
+        hx = x0 + length * cx
+        hy = y0 + length * cy
+        hc = np.floor(hx)
+        hr = np.floor(hy)
+        hit_ok = is_hit & (hc >= 0) & (hc < W) & (hr >= 0) & (hr < H)
+        hit[(hr[hit_ok] * W + hc[hit_ok]).astype(np.intp)] = True
+
+        # Clip each segment [0, length] to the grid box shrunk by _EDGE (Liang–Barsky).
+        t_lo = np.zeros_like(length)
+        t_hi = length.copy()
+        for p0, d, size in ((x0, cx, W), (y0, cy, H)):
+            lo_edge, hi_edge = _EDGE, size - _EDGE
+            moving = np.abs(d) > 1e-12
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ta = (lo_edge - p0) / d
+                tb = (hi_edge - p0) / d
+            t_lo = np.where(moving, np.maximum(t_lo, np.minimum(ta, tb)), t_lo)
+            t_hi = np.where(moving, np.minimum(t_hi, np.maximum(ta, tb)), t_hi)
+            if not lo_edge <= p0 <= hi_edge:  # parallel beams outside this slab never enter
+                t_hi = np.where(moving, t_hi, -1.0)
+        inside = t_lo <= t_hi
+        if not np.any(inside):
+            return hit.reshape(H, W), free.reshape(H, W)
+        cx, cy, t_lo, t_hi = cx[inside], cy[inside], t_lo[inside], t_hi[inside]
+        xs, ys = x0 + t_lo * cx, y0 + t_lo * cy
+        xe, ye = x0 + t_hi * cx, y0 + t_hi * cy
+
+        # First and last cell of every segment.
+        ends_c = np.floor(np.concatenate([xs, xe])).astype(np.intp)
+        ends_r = np.floor(np.concatenate([ys, ye])).astype(np.intp)
+        free[ends_r * W + ends_c] = True
+
+        # Crossings of the grid lines along the major axis; for x-major beams the crossing of
+        # the line x = i at height y marks cells (⌊y⌋, i − 1) and (⌊y⌋, i).
+        free2 = free.reshape(H, W)
+        x_major = np.abs(cx) >= np.abs(cy)
+        for along_x, major, ms, me, ns, d_major, d_minor in (
+            (True, x_major, xs, xe, ys, cx, cy),
+            (False, ~x_major, ys, ye, xs, cy, cx),
+        ):
+            if not np.any(major):
+                continue
+            a, b = ms[major], me[major]
+            m = d_minor[major] / d_major[major]  # change of the minor coordinate per major cell
+            lo = np.floor(np.minimum(a, b))
+            n = (np.floor(np.maximum(a, b)) - lo).astype(np.intp)  # grid lines in (min, max]
+            keep = n > 0
+            if not np.any(keep):
+                continue
+            first = lo[keep] + 1.0  # the first grid line crossed
+            m = m[keep]
+            minor0 = ns[major][keep] + (first - a[keep]) * m  # the minor coordinate there
+            # k-th line of each beam; padding repeats a beam's last line (duplicates are harmless).
+            # In-place int32 arithmetic; truncation is floor() here since all points are ≥ 0.
+            k = np.minimum(
+                np.arange(int(n.max()), dtype=np.int32)[None, :],
+                (n[keep] - 1).astype(np.int32)[:, None],
+            )
+            minor_f = k * m[:, None]
+            minor_f += minor0[:, None]
+            minor = minor_f.astype(np.int32)
+            line = k
+            line += first.astype(np.int32)[:, None]
+            if along_x:  # line = column i, minor = row: cells (row, i) and (row, i − 1)
+                minor *= W
+                minor += line
+            else:  # line = row j, minor = column: cells (j, col) and (j − 1, col)
+                line *= W
+                minor += line
+            crossed = np.zeros(H * W, dtype=bool)
+            crossed[minor] = True
+            c2 = crossed.reshape(H, W)
+            free2 |= c2
+            if along_x:
+                free2[:, :-1] |= c2[:, 1:]
+            else:
+                free2[:-1, :] |= c2[1:, :]
+        return hit.reshape(H, W), free2
+
+    # ------------------------------------------------------------------ nav_msgs / map_server
+
+    def to_occupancy_values(
+        self, free_thresh: float = FREE_THRESH, occupied_thresh: float = OCCUPIED_THRESH
+    ) -> NDArray[np.int8]:
+        """nav_msgs/OccupancyGrid ``data``: int8, row-major, row 0 at the origin, length W·H.
+
+        A cell is unknown (−1) when its state is UNKNOWN under the trinary thresholds
+        (free_thresh ≤ p ≤ occupied_thresh), so a merely glimpsed cell is not reported as known.
+        Known cells get round(100·p), nudged where needed so that the value keeps its state:
+        free cells at most the largest v with v/100 < free_thresh (19 by default), occupied cells
+        at least the smallest v with v/100 > occupied_thresh (66). So
+        :meth:`from_occupancy_values` gives back the same :meth:`states`.
+        """
+        p = self.prob()
+        states = self.states(free_thresh, occupied_thresh)
+        values = np.rint(100.0 * p)
+        grades = np.arange(101)
+        below = grades[grades / 100.0 < free_thresh]
+        above = grades[grades / 100.0 > occupied_thresh]
+        out = np.full(p.shape, -1, dtype=np.int8)
+        if below.size:
+            free = states == FREE
+            out[free] = np.minimum(values[free], below.max())
+        if above.size:
+            occupied = states == OCCUPIED
+            out[occupied] = np.maximum(values[occupied], above.min())
+        return out.ravel()
+
+    def save_map_server(
+        self,
+        yaml_path: str | os.PathLike[str],
+        free_thresh: float = FREE_THRESH,
+        occupied_thresh: float = OCCUPIED_THRESH,
+    ) -> tuple[Path, Path]:
+        """Write ``<name>.yaml`` and ``<name>.pgm`` as ROS map_saver does in trinary mode.
+
+        ``yaml_path`` may end in ``.yaml``/``.yml``; otherwise ``.yaml`` is appended. Cells are
+        classified with :meth:`states` (``free_thresh`` / ``occupied_thresh``) and written as
+        free 254, occupied 0, unknown 205 in a binary 8-bit PGM (P5) whose first row is the top of
+        the map (highest y). The YAML always carries map_server's standard ``occupied_thresh:
+        0.65`` and ``free_thresh: 0.196``, which decode 254/0/205 back to free/occupied/unknown.
+        Both files are written to temporary files and moved into place (``os.replace``), so an
+        error leaves no partial file. Returns (yaml path, pgm path).
+        """
+        yaml_file = Path(yaml_path)
+        if yaml_file.suffix.lower() not in (".yaml", ".yml"):
+            yaml_file = yaml_file.with_name(yaml_file.name + ".yaml")
+        pgm_file = yaml_file.with_suffix(".pgm")
+        states = self.states(free_thresh, occupied_thresh)
+        pixels = np.full(states.shape, PGM_UNKNOWN, dtype=np.uint8)
+        pixels[states == FREE] = PGM_FREE
+        pixels[states == OCCUPIED] = PGM_OCCUPIED
+        pixels = pixels[::-1]  # first image row = top of the map
+        header = (
+            f"P5\n# CREATOR: pfctl {self.resolution:.3f} m/pix\n{self.width} {self.height}\n255\n"
+        ).encode("ascii")
+        meta = {
+            "image": pgm_file.name,
+            "resolution": float(self.resolution),
+            "origin": [float(self.origin[0]), float(self.origin[1]), 0.0],
+            "negate": 0,
+            "occupied_thresh": OCCUPIED_THRESH,
+            "free_thresh": FREE_THRESH,
+            "mode": "trinary",
+        }
+        text = yaml.safe_dump(meta, sort_keys=False, default_flow_style=None)
+        pgm_tmp = yaml_tmp = None
+        try:
+            pgm_tmp = _write_temp(pgm_file, header + np.ascontiguousarray(pixels).tobytes())
+            yaml_tmp = _write_temp(yaml_file, text.encode("utf-8"))
+            os.replace(pgm_tmp, pgm_file)
+            pgm_tmp = None
+            os.replace(yaml_tmp, yaml_file)
+            yaml_tmp = None
+        except OSError as err:
+            raise GridFileError(f"{yaml_file}: cannot write map: {err.strerror or err}") from err
+        finally:
+            for tmp in (pgm_tmp, yaml_tmp):
+                if tmp is not None:
+                    with contextlib.suppress(OSError):
+                        os.unlink(tmp)
+        return yaml_file, pgm_file
+
+    @classmethod
+    def load_map_server(
+        cls, yaml_path: str | os.PathLike[str], sensor_model: InverseSensorModel | None = None
+    ) -> OccupancyGrid:
+        """Read a ROS map_server map (YAML + PGM image) as the map_server node would.
+
+        The YAML needs ``image`` (absolute, or relative to the YAML's folder), ``resolution`` and
+        ``origin`` [x, y, yaw]; ``negate`` (0), ``occupied_thresh`` (0.65), ``free_thresh``
+        (0.196) and ``mode`` (trinary) are optional. Only yaw = 0 is supported. The image must be
+        a PGM: binary P5 (8 or 16 bit) or ASCII P2; values are scaled to 0..255 and the first
+        image row is the top of the map. Per pixel x, p = (255 − x)/255, or x/255 with negate;
+        then, as map_server does:
+
+        - trinary: p > occupied_thresh → occupied (stored as p = 1, saturated), p < free_thresh →
+          free (p = 0, saturated), otherwise unknown (p = 0.5);
+        - scale: as trinary for the extremes, otherwise the value 99·(p − free)/(occ − free),
+          stored as p = value/100;
+        - raw: the value x itself (after negate) is the occupancy 0..100, stored as p = x/100;
+          x ≥ 101 (255 = −1 as int8) is unknown.
+
+        Anything wrong with either file raises :class:`GridFileError` naming the file.
+        """
+        path = Path(yaml_path)
+        meta = _read_yaml(path)
+        image_name = _field(meta, "image", path, str)
+        resolution = _number(meta, "resolution", path)
+        if not resolution > 0:
+            raise GridFileError(f"{path}: resolution must be > 0, got {resolution}")
+        origin = meta.get("origin")
+        if origin is None:
+            raise GridFileError(f"{path}: missing required key 'origin'")
+        if not isinstance(origin, list) or len(origin) not in (2, 3):
+            raise GridFileError(f"{path}: origin must be a list [x, y, yaw], got {origin!r}")
+        if not all(_is_number(v) and math.isfinite(v) for v in origin):
+            raise GridFileError(f"{path}: origin must hold finite numbers, got {origin!r}")
+        if len(origin) == 3 and abs(float(origin[2])) > 1e-12:
+            raise GridFileError(
+                f"{path}: origin yaw {origin[2]} is not supported (only unrotated maps, yaw 0)"
+            )
+        negate = meta.get("negate", 0)
+        if negate not in (0, 1) or not isinstance(negate, (int, bool)):
+            raise GridFileError(f"{path}: negate must be 0 or 1, got {negate!r}")
+        occ_th = _number(meta, "occupied_thresh", path, OCCUPIED_THRESH)
+        free_th = _number(meta, "free_thresh", path, FREE_THRESH)
+        if not 0.0 <= free_th < occ_th <= 1.0:
+            raise GridFileError(
+                f"{path}: need 0 ≤ free_thresh < occupied_thresh ≤ 1, got {free_th}, {occ_th}"
+            )
+        mode = meta.get("mode", "trinary")
+        if mode not in _MAP_MODES:
+            raise GridFileError(
+                f"{path}: mode must be one of {', '.join(_MAP_MODES)}, got {mode!r}"
+            )
+
+        image_path = Path(image_name)
+        if not image_path.is_absolute():
+            image_path = path.parent / image_path
+        color = read_pgm(image_path)  # float 0..255, first row = top
+        if negate:
+            color = 255.0 - color
+        if mode == "raw":
+            raw = np.rint(color)
+            values = np.where(raw <= 100, raw, -1)
+        else:
+            p = (255.0 - color) / 255.0
+            if mode == "trinary":
+                middle = np.full(p.shape, -1.0)
+            else:
+                middle = np.rint(99.0 * (p - free_th) / (occ_th - free_th))
+            values = np.where(p > occ_th, 100, np.where(p < free_th, 0, middle))
+        values = values[::-1].astype(np.int64)  # row 0 = bottom of the map
+        height, width = values.shape
+        return cls.from_occupancy_values(
+            values, width, height, resolution, (float(origin[0]), float(origin[1])), sensor_model
+        )
+
+
+# ------------------------------------------------------------------------------------ helpers
+
+
+def _origin(origin: Sequence[float]) -> tuple[float, float]:
+    if len(origin) != 2:
+        raise ValueError(f"origin must be (x, y), got {origin!r}")
+    return (float(origin[0]), float(origin[1]))
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool)
+
+
+def _field(meta: dict[str, Any], key: str, path: Path, kind: type) -> Any:
+    if key not in meta:
+        raise GridFileError(f"{path}: missing required key '{key}'")
+    value = meta[key]
+    if not isinstance(value, kind) or (kind is str and not value):
+        raise GridFileError(f"{path}: {key} must be a {kind.__name__}, got {value!r}")
+    return value
+
+
+def _number(meta: dict[str, Any], key: str, path: Path, default: float | None = None) -> float:
+    if key not in meta:
+        if default is None:
+            raise GridFileError(f"{path}: missing required key '{key}'")
+        return default
+    value = meta[key]
+    if not _is_number(value) or not math.isfinite(value):
+        raise GridFileError(f"{path}: {key} must be a finite number, got {value!r}")
+    return float(value)
+
+
+def _read_yaml(path: Path) -> dict[str, Any]:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError as err:
+        raise GridFileError(f"{path}: map YAML not found") from err
+    except (OSError, UnicodeDecodeError) as err:
+        raise GridFileError(f"{path}: cannot read map YAML: {err}") from err
+    try:
+        meta = yaml.safe_load(text)
+    except yaml.YAMLError as err:
+        where = getattr(err, "problem_mark", None)
+        line = f" at line {where.line + 1}" if where is not None else ""
+        problem = getattr(err, "problem", None) or "syntax error"
+        raise GridFileError(f"{path}: invalid YAML{line}: {problem}") from err
+    if not isinstance(meta, dict):
+        raise GridFileError(f"{path}: map YAML must be a mapping of keys to values")
+    return meta
+
+
+def read_pgm(path: str | os.PathLike[str]) -> NDArray[np.float64]:
+    """Pixels of a PGM image as floats scaled to 0..255, shape (rows, cols), first row = top.
+
+    Reads binary P5 (maxval ≤ 255: 1 byte per pixel; up to 65535: 2 bytes, big-endian) and ASCII
+    P2, with ``#`` comments in the header. Raises :class:`GridFileError` naming the file.
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError as err:
+        raise GridFileError(f"{path}: map image not found") from err
+    except OSError as err:
+        raise GridFileError(f"{path}: cannot read map image: {err.strerror or err}") from err
+    magic = data[:2]
+    if magic not in (b"P5", b"P2"):
+        shown = magic.decode("latin-1") if magic[:1] == b"P" else "not a PNM file"
+        raise GridFileError(
+            f"{path}: unsupported image ({shown}); only PGM (P5 binary or P2 ASCII) is read"
+        )
+    tokens: list[int] = []
+    pos = 2
+    while len(tokens) < 3:
+        while pos < len(data) and data[pos : pos + 1].isspace():
+            pos += 1
+        if pos < len(data) and data[pos : pos + 1] == b"#":
+            end = data.find(b"\n", pos)
+            pos = len(data) if end < 0 else end + 1
+            continue
+        start = pos
+        while pos < len(data) and not data[pos : pos + 1].isspace() and data[pos] != ord("#"):
+            pos += 1
+        token = data[start:pos]
+        if not token.isdigit():
+            raise GridFileError(f"{path}: bad PGM header (expected width, height and maxval)")
+        tokens.append(int(token))
+    width, height, maxval = tokens
+    if width < 1 or height < 1 or not 0 < maxval < 65536:
+        raise GridFileError(f"{path}: bad PGM header (size {width}×{height}, maxval {maxval})")
+    count = width * height
+    if magic == b"P5":
+        if pos >= len(data) or not data[pos : pos + 1].isspace():
+            raise GridFileError(f"{path}: bad PGM header (no whitespace after maxval)")
+        pos += 1
+        dtype = np.dtype(">u2") if maxval > 255 else np.dtype(np.uint8)
+        if len(data) - pos < count * dtype.itemsize:
+            raise GridFileError(
+                f"{path}: PGM pixel data truncated ({len(data) - pos} bytes, "
+                f"{count * dtype.itemsize} expected)"
+            )
+        pixels = np.frombuffer(data, dtype=dtype, count=count, offset=pos).astype(np.int64)
+    else:
+        body = b"\n".join(line.split(b"#", 1)[0] for line in data[pos:].splitlines())
+        words = body.split()
+        if len(words) != count or not all(w.isdigit() for w in words):
+            raise GridFileError(f"{path}: P2 pixel data must be {count} non-negative integers")
+        pixels = np.array([int(w) for w in words], dtype=np.int64)
+    if pixels.size and int(pixels.max()) > maxval:
+        raise GridFileError(f"{path}: PGM pixel value above maxval {maxval}")
+    return pixels.reshape(height, width) * (255.0 / maxval)
+
+
+def write_pgm(path: str | os.PathLike[str], pixels: ArrayLike) -> None:
+    """Write a uint8 array (first row = top of the image) as a binary PGM (P5), atomically."""
+    image = np.ascontiguousarray(np.asarray(pixels, dtype=np.uint8))
+    if image.ndim != 2:
+        raise ValueError(f"a PGM image is 2-D, got shape {image.shape}")
+    header = f"P5\n{image.shape[1]} {image.shape[0]}\n255\n".encode("ascii")
+    target = Path(path)
+    tmp = _write_temp(target, header + image.tobytes())
+    try:
+        os.replace(tmp, target)
+    except OSError:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _write_temp(target: Path, payload: bytes) -> str:
+    """Write ``payload`` to a new temporary file beside ``target``; return its name."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(payload)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    return tmp
