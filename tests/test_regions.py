@@ -242,3 +242,24 @@ def test_waypoint_utilities_are_eq3(rmap: RegionMap) -> None:
         assert u == pytest.approx(
             utility(cluster, robot, decision.target_point, SEARCH["alpha"], from_x, to_l)
         )
+
+
+def test_waypoint_search_ignores_frontiers_beyond_the_house(rmap: RegionMap) -> None:
+    """A gap in the kitchen's outer wall opens onto unknown space outside every region: a frontier
+    of the raw grid, but the person is in the house, so Algorithm 1 does not go there."""
+    margin = 40  # 2 m of unknown space around the house
+    p = np.pad(_house_probabilities(("office",)), margin, constant_values=0.5)
+    gap = slice(margin + 76, margin + 92)  # x in [3.8, 4.6] m on the south wall (y = 0)
+    p[margin - 1 : margin + 1, gap] = 0.0
+    grid = OccupancyGrid.from_probabilities(p, RES, origin=(-2.0, -2.0))
+    walk = _walk((5.5, 4.5), (4.2, 5.6))  # toward the office door
+
+    def at_gap(decision) -> list[bool]:
+        return [3.7 < c.centroid[0] < 4.7 and c.centroid[1] < 0.1 for c in decision.clusters]
+
+    raw = waypoint_search(grid, rmap, walk, (3.0, 2.0), **SEARCH, confine_to_regions=False)
+    confined = waypoint_search(grid, rmap, walk, (3.0, 2.0), **SEARCH)
+    assert any(at_gap(raw))
+    assert not any(at_gap(confined)) and confined.reason == "frontier"
+    assert confined.heading_region == "office"
+    assert all(rmap.locate(g) is not None for g in confined.goals)

@@ -100,6 +100,7 @@ class RegionMap:
                 graph.add_edge(a, b, doors=(door,))
             graph.edges[a, b].update(segment=door.segment, midpoint=mid, weight=weight)
         self.graph = graph
+        self._inside_masks: dict[GridGeometry, NDArray[np.bool_]] = {}
 
     @property
     def names(self) -> list[str]:
@@ -149,6 +150,22 @@ class RegionMap:
         if not self.graph.has_edge(a, b):
             return ()
         return tuple(self.graph.edges[a, b]["doors"])
+
+    def inside_mask(self, geometry: GridGeometry) -> NDArray[np.bool_]:
+        """Cells of a grid with ``geometry`` that belong to the house: True where the cell centre
+        lies within one cell size of some region (so the wall lines on region boundaries and
+        the door openings count as inside). Computed once per geometry and cached; read-only.
+        """
+        mask = self._inside_masks.get(geometry)
+        if mask is None:
+            house = shapely.unary_union(list(self._polygons.values())).buffer(geometry.resolution)
+            shapely.prepare(house)
+            rows, cols = np.mgrid[0 : geometry.height, 0 : geometry.width]
+            centres = geometry.cell_to_world(rows, cols)
+            mask = shapely.contains_xy(house, centres[..., 0], centres[..., 1])
+            mask.flags.writeable = False
+            self._inside_masks[geometry] = mask
+        return mask
 
     def region_point(self, name: str) -> XY:
         """The point that stands for region ``name``: its centroid, or a point surely inside
@@ -276,6 +293,7 @@ def waypoint_search(
     downsample: int | None = None,
     free_thresh: float = FREE_THRESH,
     occupied_thresh: float = OCCUPIED_THRESH,
+    confine_to_regions: bool = True,
 ) -> WaypointDecision:
     """**Algorithm 1**, way-point search, end to end (§II-B/C/D).
 
@@ -291,6 +309,10 @@ def waypoint_search(
        one from l*, confined to the known map and the two start points grown by
        ``paths.SEARCH_MARGIN`` = 2 m). With
        no l* at all the d(c, l*) term is dropped and c is the point closest to the robot.
+    With ``confine_to_regions`` (the default), cells outside every region count as obstacles:
+    the person is somewhere in the house, so frontiers outside it are not worth a look, and a
+    path must not cut through unexplored space beyond the walls (it would underestimate d).
+
     4. The way-point is the c of the best utility (first cluster on ties; clusters come largest
        first). Without any reachable cluster: l*'s point — moved to the nearest non-occupied
        cell of the region if the grid has it occupied — or, lacking l*, the robot's position.
@@ -307,6 +329,8 @@ def waypoint_search(
 
     geometry = grid.geometry
     states = grid_states(grid, free_thresh, occupied_thresh)
+    if confine_to_regions:
+        states = np.where(region_map.inside_mask(geometry), states, np.int8(OCCUPIED))
     clusters = frontiers_from_states(states, geometry, beta, frontier_threshold, min_frontier_cells)
     goals: list[XY] = []
     utilities: list[float] = []

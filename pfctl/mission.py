@@ -1,0 +1,1171 @@
+"""The mission YAML: pydantic models of every section, and ``load_mission()`` with one-line errors.
+
+This module is the only place that knows the mission file format (DESIGN.md). Everything below
+it receives plain typed objects: :meth:`Mission.layout` turns the ``map`` section into the
+:class:`pfctl.core.house.HouseLayout` value types, and the other sections are small frozen models
+whose fields are SI values.
+
+A mission is checked in three layers, and every failure becomes a :class:`pfctl.errors.MissionError`
+whose message is one line, ``<file>:<line>: <key.path[2].sub>: <what was expected>``:
+
+1. reading: missing file, a directory, not UTF-8, empty, YAML syntax, duplicate keys;
+2. shape: unknown keys, wrong types, ranges (pydantic, ``extra="forbid"`` everywhere);
+3. meaning: polygons are simple with >= 3 distinct points, regions do not overlap, doors lie on
+   the wall two existing regions share, the scenario's target and routes name existing things.
+
+The line is found by composing the YAML node graph and walking it along the error's key path to
+the deepest node that exists.
+
+Example::
+
+    mission = load_mission("missions/house.yaml")
+    layout = mission.layout()          # HouseLayout: regions, doors, obstacles
+    mission.behavior.tree.size()       # number of behavior-tree nodes
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+from collections.abc import Iterator, Mapping, Sequence
+from pathlib import Path
+from typing import Annotated, Any, Literal, Union, get_args, get_origin
+
+import shapely
+import yaml
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    BeforeValidator,
+    ConfigDict,
+    Discriminator,
+    Field,
+    Tag,
+    ValidationError,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
+from shapely.validation import explain_validity
+
+from pfctl.core.house import Door, HouseLayout, Obstacle, Region
+from pfctl.errors import MissionError
+
+__all__ = [
+    "BehaviorConfig",
+    "BeliefConfig",
+    "Clothes",
+    "Composite",
+    "Decorator",
+    "DoorSpec",
+    "MapConfig",
+    "Mission",
+    "ObstacleSpec",
+    "Parallel",
+    "PerceptionConfig",
+    "Person",
+    "Pose",
+    "PredictionConfig",
+    "RegionSpec",
+    "Repeat",
+    "Retry",
+    "RobotConfig",
+    "ScenarioConfig",
+    "SearchConfig",
+    "SensorModel",
+    "SvrParams",
+    "Timeout",
+    "TrackingConfig",
+    "TreeNode",
+    "Weighting",
+    "dump_json_schema",
+    "load_mission",
+    "loads_mission",
+]
+
+#: Geometric tolerance of the semantic checks, metres (and m² for areas).
+TOLERANCE = 1e-6
+
+# --------------------------------------------------------------------------------------------
+# Scalar types
+# --------------------------------------------------------------------------------------------
+
+
+def _error(kind: str, message: str) -> PydanticCustomError:
+    """A validation error whose message is ``message`` verbatim (no template expansion)."""
+    return PydanticCustomError(kind, "{detail}", {"detail": message})
+
+
+def _reject_bool(value: Any) -> Any:
+    """YAML's ``yes``/``true`` must not silently become 1: numbers reject booleans."""
+    if isinstance(value, bool):
+        raise _error("bool_not_number", f"expected a number, got the boolean {str(value).lower()}")
+    return value
+
+
+def _snake_case(value: str) -> str:
+    """Behavior-tree leaf names are snake_case identifiers (``target_visible``)."""
+    if not re.fullmatch(r"[a-z][a-z0-9_]*", value):
+        raise _error(
+            "snake_case", f"expected a snake_case name such as 'target_visible', got {value!r}"
+        )
+    return value
+
+
+_NO_BOOL = BeforeValidator(_reject_bool)
+# Constraints come before the validator so that pydantic folds them into the number schema
+# (and the JSON Schema says exclusiveMinimum, not an unknown "gt").
+Number = Annotated[float, Field(allow_inf_nan=False), _NO_BOOL]
+"""A finite float; booleans are rejected."""
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False), _NO_BOOL]
+NonNegative = Annotated[float, Field(ge=0, allow_inf_nan=False), _NO_BOOL]
+Probability = Annotated[float, Field(gt=0, lt=1), _NO_BOOL]
+"""A probability in the open interval (0, 1)."""
+UnitInterval = Annotated[float, Field(ge=0, le=1), _NO_BOOL]
+Integer = Annotated[int, _NO_BOOL]
+Count = Annotated[int, Field(ge=1), _NO_BOOL]
+Name = Annotated[str, Field(min_length=1)]
+Identifier = Annotated[
+    str, AfterValidator(_snake_case), Field(json_schema_extra={"pattern": "^[a-z][a-z0-9_]*$"})
+]
+Point = tuple[Number, Number]
+"""An ``[x, y]`` point in the map frame, metres."""
+Channel = Annotated[int, Field(ge=0, le=255), _NO_BOOL]
+RGB = tuple[Channel, Channel, Channel]
+
+
+def _fmt_point(p: Sequence[float]) -> str:
+    return f"({p[0]:g}, {p[1]:g})"
+
+
+def _check_polygon(points: tuple[Point, ...]) -> tuple[Point, ...]:
+    """A simple polygon of >= 3 distinct points; a repeated closing point is dropped."""
+    pts = list(points)
+    if len(pts) >= 2 and pts[0] == pts[-1]:
+        pts.pop()
+    distinct = len(set(pts))
+    if distinct < 3:
+        raise _error(
+            "polygon_points",
+            f"expected a polygon of at least 3 distinct [x, y] points, got {distinct}",
+        )
+    if shapely.LineString(pts).convex_hull.area <= TOLERANCE**2:
+        raise _error(
+            "polygon_area", "expected a polygon with an area, but its points are collinear"
+        )
+    polygon = shapely.Polygon(pts)
+    if not polygon.is_valid:
+        reason = explain_validity(polygon)
+        match = re.fullmatch(r"(.*?)\[\s*(\S+)\s+(\S+)\s*\]", reason)
+        if match:
+            where = _fmt_point((float(match.group(2)), float(match.group(3))))
+            reason = f"{match.group(1).lower()} at {where}"
+        raise _error(
+            "polygon_invalid", f"expected a simple polygon (edges that do not cross), got {reason}"
+        )
+    return tuple(pts)
+
+
+Polygon = Annotated[tuple[Point, ...], AfterValidator(_check_polygon)]
+"""A simple polygon: >= 3 distinct points, not self-intersecting; closing point optional."""
+
+
+def _fail(loc: tuple[str | int, ...], message: str, more: int = 0) -> PydanticCustomError:
+    """A semantic error at ``loc`` *relative to* the model that raises it.
+
+    Pydantic gives model validators no way to point deeper than the model, so the relative key
+    path travels in the error's context and :func:`_format_error` appends it. ``more`` counts
+    further semantic errors found in the same pass.
+    """
+    return PydanticCustomError("mission", "{detail}", {"detail": message, "loc": loc, "more": more})
+
+
+def _raise_first(issues: list[tuple[tuple[str | int, ...], str]]) -> None:
+    """Raise the first of ``issues`` (relative key path, message), counting the rest."""
+    if issues:
+        loc, message = issues[0]
+        raise _fail(loc, message, more=len(issues) - 1)
+
+
+class _Model(BaseModel):
+    """Base of every mission model: unknown keys are errors, values are immutable."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True, use_attribute_docstrings=True)
+
+
+# --------------------------------------------------------------------------------------------
+# map
+# --------------------------------------------------------------------------------------------
+
+
+class SensorModel(_Model):
+    """Inverse sensor model of Eq. 1: p(occupied | what the beam did), and the clamping bounds."""
+
+    p_hit: Annotated[float, Field(gt=0.5, lt=1), _NO_BOOL] = 0.7
+    """p(occupied | the beam ended in the cell)."""
+    p_miss: Annotated[float, Field(gt=0, lt=0.5), _NO_BOOL] = 0.4
+    """p(occupied | the beam passed through the cell)."""
+    p_min: Probability = 0.02
+    """Lower clamp of p(m), so the map can still change its mind."""
+    p_max: Probability = 0.98
+    """Upper clamp of p(m); greater than p_min."""
+
+    @model_validator(mode="after")
+    def _bounds_ordered(self) -> SensorModel:
+        if self.p_min >= self.p_max:
+            raise _fail(("p_max",), f"expected p_max > p_min ({self.p_min:g}), got {self.p_max:g}")
+        return self
+
+
+class RegionSpec(_Model):
+    """A named polygon of the region map (§II-B)."""
+
+    name: Name
+    polygon: Polygon
+
+
+class DoorSpec(_Model):
+    """An opening in the wall two regions share: ``segment`` lies on their common boundary."""
+
+    between: tuple[Name, Name]
+    """The names of the two regions the door joins."""
+    segment: tuple[Point, Point]
+    """The opening: two [x, y] end points on the shared wall."""
+
+
+class ObstacleSpec(_Model):
+    """A static obstacle (furniture): a polygon and its height for the simulator, metres."""
+
+    name: str = ""
+    polygon: Polygon
+    height: Positive = 0.8
+
+
+class MapConfig(_Model):
+    """The static house: grid resolution, walls, the sensor model, regions, doors, obstacles."""
+
+    resolution: Positive = 0.05
+    """Metres per cell of every grid (occupancy, belief)."""
+    occupancy: Path | None = None
+    """Optional ROS map_server YAML, relative to the mission file; else walls come from polygons."""
+    wall_thickness: Positive = 0.1
+    """Metres."""
+    wall_height: Positive = 2.2
+    """Metres, for the simulator."""
+    sensor_model: SensorModel = SensorModel()
+    regions: Annotated[tuple[RegionSpec, ...], Field(min_length=1)]
+    """Rooms as polygons; they may share edges but not area."""
+    doors: tuple[DoorSpec, ...] = ()
+    """Openings, each on the wall shared by two regions."""
+    obstacles: tuple[ObstacleSpec, ...] = ()
+    """Furniture."""
+
+    @field_validator("occupancy")
+    @classmethod
+    def _occupancy_exists(cls, value: Path | None, info: ValidationInfo) -> Path | None:
+        """Resolve the map_server YAML relative to the mission file and check that it exists."""
+        if value is None:
+            return None
+        context = info.context if isinstance(info.context, Mapping) else {}
+        base = Path(context.get("base_dir", "."))
+        path = value if value.is_absolute() else base / value
+        if not path.is_file():
+            raise _error(
+                "file_missing",
+                f"expected an existing map_server YAML file, but {path} does not exist",
+            )
+        return path.resolve()
+
+    @model_validator(mode="after")
+    def _geometry(self) -> MapConfig:
+        """Unique region names, no overlapping regions, doors on the walls of existing regions."""
+        issues: list[tuple[tuple[str | int, ...], str]] = []
+        polygons: dict[str, shapely.Polygon] = {}
+        first_index: dict[str, int] = {}
+        for i, region in enumerate(self.regions):
+            if region.name in first_index:
+                issues.append(
+                    (
+                        ("regions", i, "name"),
+                        f"duplicate region name {region.name!r} "
+                        f"(already used by regions[{first_index[region.name]}])",
+                    )
+                )
+                continue
+            first_index[region.name] = i
+            polygon = shapely.Polygon(region.polygon)
+            for other, other_polygon in polygons.items():
+                common = polygon.intersection(other_polygon).area
+                if common > TOLERANCE:
+                    issues.append(
+                        (
+                            ("regions", i, "polygon"),
+                            f"region {region.name!r} overlaps region {other!r} by {common:.3g} m²;"
+                            " regions may share edges but not area",
+                        )
+                    )
+            polygons[region.name] = polygon
+        known = ", ".join(polygons)
+        for i, door in enumerate(self.doors):
+            a, b = door.between
+            unknown = [n for n in (a, b) if n not in polygons]
+            if unknown:
+                issues.append(
+                    (("doors", i, "between"), f"unknown region {unknown[0]!r} (regions: {known})")
+                )
+                continue
+            if a == b:
+                issues.append(
+                    (
+                        ("doors", i, "between"),
+                        f"expected two different regions, got {a!r} twice",
+                    )
+                )
+                continue
+            issue = _door_issue(door, polygons[a], polygons[b])
+            if issue:
+                issues.append((("doors", i, "segment"), issue))
+        _raise_first(issues)
+        return self
+
+
+def _lines_of(geometry: shapely.Geometry) -> list[shapely.LineString]:
+    """The line pieces of ``geometry`` (an intersection may mix points and lines), merged."""
+    parts = getattr(geometry, "geoms", [geometry])
+    lines = [g for g in parts if g.geom_type in ("LineString", "LinearRing") and not g.is_empty]
+    if not lines:
+        return []
+    merged = shapely.line_merge(shapely.MultiLineString(lines))
+    return [g for g in getattr(merged, "geoms", [merged]) if g.length > TOLERANCE]
+
+
+def _door_issue(door: DoorSpec, a: shapely.Polygon, b: shapely.Polygon) -> str | None:
+    """Why ``door`` is not an opening in the wall ``a`` and ``b`` share, or None if it is.
+
+    The shared wall is the part of ``a``'s boundary within :data:`TOLERANCE` of ``b``'s, so
+    edges that meet up to rounding still count; the door must lie on it within the tolerance.
+    """
+    p, q = door.segment
+    if math.dist(p, q) <= TOLERANCE:
+        return f"expected a door segment of positive length, got {_fmt_point(p)} twice"
+    walls = _lines_of(a.boundary.intersection(b.boundary.buffer(TOLERANCE)))
+    name_a, name_b = door.between
+    if sum(w.length for w in walls) <= 10 * TOLERANCE:
+        return f"regions {name_a!r} and {name_b!r} share no wall, so no door can join them"
+    segment = shapely.LineString([p, q])
+    if shapely.MultiLineString(walls).buffer(2 * TOLERANCE).covers(segment):
+        return None
+    described = "; ".join(
+        f"{_fmt_point(w.coords[0])} to {_fmt_point(w.coords[-1])}"
+        for w in walls
+        if w.length > 10 * TOLERANCE
+    )
+    return (
+        f"expected the segment {_fmt_point(p)} to {_fmt_point(q)} to lie on the wall shared by "
+        f"{name_a!r} and {name_b!r}: {described}"
+    )
+
+
+# --------------------------------------------------------------------------------------------
+# robot, perception, tracking, belief, prediction, search
+# --------------------------------------------------------------------------------------------
+
+
+class Pose(_Model):
+    """A pose in the map frame: metres and radians (REP-103)."""
+
+    x: Number
+    y: Number
+    theta: Number = 0.0
+
+
+def _check_limits(value: tuple[float, float]) -> tuple[float, float]:
+    """A ``[low, high]`` pair must have ``low < high``."""
+    if value[0] >= value[1]:
+        raise _error(
+            "limits_order",
+            f"expected [low, high] with low < high, got [{value[0]:g}, {value[1]:g}]",
+        )
+    return value
+
+
+Limits = Annotated[tuple[Number, Number], AfterValidator(_check_limits)]
+"""A ``[low, high]`` joint-limit pair in radians, ``low < high``."""
+
+
+class RobotConfig(_Model):
+    """The robot's size and limits; the defaults are the Toyota HSR's (§III-A)."""
+
+    radius: Positive = 0.215
+    max_linear_speed: Positive = 0.22
+    """m/s (omnidirectional base)."""
+    max_angular_speed: Positive = 0.8
+    """rad/s."""
+    head_pan_limits: Limits = (-3.84, 1.75)
+    head_tilt_limits: Limits = (-1.57, 0.52)
+    head_max_speed: Positive = 1.0
+    """rad/s."""
+    start: Pose | None = None
+    """Where the robot starts; None: a point inside the first region."""
+
+
+class PerceptionConfig(_Model):
+    """Thresholds of leg detection and target identification (§II-E, Algorithm 2)."""
+
+    leg_probability: Probability = 0.5
+    """Random-forest score above which a laser segment is a leg."""
+    face_distance: Positive = 0.6
+    """Face-embedding distance below which two faces match."""
+    clothes_similarity: UnitInterval = 0.6
+    """Histogram intersection S above which clothes match (Algorithm 2)."""
+
+
+class TrackingConfig(_Model):
+    """Noise of the constant-velocity Kalman filters and the association gate (§II-E)."""
+
+    process_noise: Positive = 0.5
+    """Std of the white-noise acceleration, m/s²."""
+    laser_noise: Positive = 0.05
+    """Std of a leg-pair position, m."""
+    camera_noise: Positive = 0.15
+    """Std of a camera position, m."""
+    gate: Positive = 9.21
+    """Squared Mahalanobis gate (chi², 2 dof, 99 %)."""
+
+
+class BeliefConfig(_Model):
+    """The human belief grid of Eq. 4."""
+
+    prior: Probability = 0.05
+    p_o_given_h: Annotated[float, Field(gt=0, le=1), _NO_BOOL] = 0.9
+    """p(person detected | person in the cell)."""
+    p_o_given_not_h: Annotated[float, Field(ge=0, lt=1), _NO_BOOL] = 0.05
+    """p(person detected | no person in the cell)."""
+    decay_per_s: NonNegative = 0.0
+
+    @model_validator(mode="after")
+    def _informative(self) -> BeliefConfig:
+        if self.p_o_given_h <= self.p_o_given_not_h:
+            raise _fail(
+                ("p_o_given_h",),
+                f"expected p_o_given_h > p_o_given_not_h ({self.p_o_given_not_h:g}), "
+                f"else a detection is no evidence; got {self.p_o_given_h:g}",
+            )
+        return self
+
+
+class SvrParams(_Model):
+    """Hyper-parameters of the RBF support-vector regressor (the paper: C=1000, ε=0.01, γ=1)."""
+
+    C: Positive = 1000.0
+    epsilon: Positive = 0.01
+    gamma: Positive = 1.0
+
+
+class Weighting(_Model):
+    """Sample weights of the trajectory fit: recent samples count more."""
+
+    kind: Literal["none", "linear", "exponential"] = "exponential"
+    half_life_s: Positive = 1.0
+
+
+class PredictionConfig(_Model):
+    """Trajectory prediction of a lost target (§II-E, §III)."""
+
+    model: Literal["svr", "svr-time", "poly3", "cv"] = "svr"
+    history_s: Positive = 3.0
+    horizon_s: Positive = 3.0
+    svr: SvrParams = SvrParams()
+    weighting: Weighting = Weighting()
+
+
+class SearchConfig(_Model):
+    """Frontier map (Eq. 2), utility (Eq. 3) and way-point search (Algorithm 1)."""
+
+    alpha: NonNegative = 0.05
+    """Utility per unknown cell a frontier borders (Eq. 3)."""
+    beta: NonNegative = 1.0
+    """Weight of obstacle boundaries in the frontier map (Eq. 2)."""
+    frontier_threshold: Positive = 0.1
+    """F above which a cell is a frontier cell."""
+    heading_window_s: Positive = 3.0
+    """T: the pose history Algorithm 1 looks back over, s."""
+    min_frontier_cells: Count = 5
+    """Smaller frontier clusters are dropped."""
+
+
+# --------------------------------------------------------------------------------------------
+# behavior tree
+# --------------------------------------------------------------------------------------------
+
+COMPOSITES = ("sequence", "fallback", "parallel")
+DECORATORS = ("inverter", "retry", "timeout", "repeat", "force_success", "force_failure")
+LEAVES = ("condition", "action")
+NODE_KINDS = COMPOSITES + DECORATORS + LEAVES
+
+
+class Composite(_Model):
+    """A sequence or fallback: an optional name and a non-empty list of children."""
+
+    name: str | None = None
+    children: Annotated[tuple[TreeNode, ...], Field(min_length=1)]
+
+
+class Parallel(Composite):
+    """Ticks every child each tick; succeeds when all (or one) succeed."""
+
+    policy: Literal["success_on_all", "success_on_one"] = "success_on_all"
+
+
+class Decorator(_Model):
+    """A decorator (inverter, force_success, force_failure): one child."""
+
+    name: str | None = None
+    child: TreeNode
+
+
+class Retry(Decorator):
+    """Re-run the child after a failure, up to ``attempts`` times in all."""
+
+    attempts: Count
+
+
+class Timeout(Decorator):
+    """Fail the child if it is still running after ``seconds``."""
+
+    seconds: Positive
+
+
+class Repeat(Decorator):
+    """Run the child ``count`` times while it succeeds."""
+
+    count: Count
+
+
+class TreeNode(_Model):
+    """One behavior-tree node (Fig. 2): exactly one of the keys below, plus ``params`` on leaves.
+
+    Composites ``sequence`` / ``fallback`` / ``parallel`` hold ``{name?, children: [...]}``;
+    decorators ``inverter`` / ``retry`` / ``timeout`` / ``repeat`` / ``force_success`` /
+    ``force_failure`` hold ``{name?, child, ...}``; leaves are ``{condition: NAME, params?}`` or
+    ``{action: NAME, params?}`` with NAME a snake_case identifier.
+    """
+
+    sequence: Composite | None = None
+    fallback: Composite | None = None
+    parallel: Parallel | None = None
+    inverter: Decorator | None = None
+    retry: Retry | None = None
+    timeout: Timeout | None = None
+    repeat: Repeat | None = None
+    force_success: Decorator | None = None
+    force_failure: Decorator | None = None
+    condition: Identifier | None = None
+    action: Identifier | None = None
+    params: dict[str, Any] = Field(default_factory=dict)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _exactly_one_kind(cls, data: Any) -> Any:
+        """A node is a mapping with exactly one kind key; ``params`` only on leaves."""
+        kinds_text = ", ".join(NODE_KINDS)
+        if not isinstance(data, Mapping):
+            got = repr(data) if isinstance(data, (str, int, float)) else type(data).__name__
+            raise _error(
+                "tree_node", f"expected a tree node, a mapping with one of {kinds_text}, got {got}"
+            )
+        if any(key not in NODE_KINDS and key != "params" for key in data):
+            return data  # pydantic reports the unknown key, with the allowed ones
+        kinds = [key for key in data if key in NODE_KINDS]
+        if len(kinds) != 1:
+            got = " and ".join(repr(k) for k in kinds) if kinds else "none"
+            raise _error(
+                "tree_node", f"expected exactly one of {kinds_text} in a tree node, got {got}"
+            )
+        if "params" in data and kinds[0] not in LEAVES:
+            raise _fail(("params",), f"params belong to a condition or action leaf, not {kinds[0]}")
+        return data
+
+    @property
+    def kind(self) -> str:
+        """Which node this is: one of :data:`NODE_KINDS`."""
+        for kind in NODE_KINDS:
+            if getattr(self, kind) is not None:
+                return kind
+        raise AssertionError("a validated TreeNode always has a kind")  # pragma: no cover
+
+    @property
+    def body(self) -> Composite | Decorator | str:
+        """The value under the kind key: the composite/decorator model, or the leaf's name."""
+        return getattr(self, self.kind)  # type: ignore[no-any-return]
+
+    @property
+    def is_leaf(self) -> bool:
+        """True for condition and action leaves."""
+        return self.kind in LEAVES
+
+    @property
+    def label(self) -> str:
+        """A short human name: the leaf's name, else the node's ``name``, else its kind."""
+        body = self.body
+        if isinstance(body, str):
+            return body
+        return body.name or self.kind
+
+    @property
+    def children(self) -> tuple[TreeNode, ...]:
+        """The child nodes: a composite's children, a decorator's child, none for a leaf."""
+        body = self.body
+        if isinstance(body, Composite):
+            return body.children
+        if isinstance(body, Decorator):
+            return (body.child,)
+        return ()
+
+    def walk(self) -> Iterator[TreeNode]:
+        """This node and all below it, depth first, in order."""
+        yield self
+        for child in self.children:
+            yield from child.walk()
+
+    def size(self) -> int:
+        """The number of nodes in this subtree, this one included."""
+        return sum(1 for _ in self.walk())
+
+
+Composite.model_rebuild()
+Parallel.model_rebuild()
+Decorator.model_rebuild()
+Retry.model_rebuild()
+Timeout.model_rebuild()
+Repeat.model_rebuild()
+TreeNode.model_rebuild()
+
+
+def _paper_tree() -> TreeNode:
+    """Fig. 2 of the paper: follow while visible, else predict and look, else way-point search."""
+    return TreeNode.model_validate(
+        {
+            "fallback": {
+                "name": "root",
+                "children": [
+                    {
+                        "sequence": {
+                            "name": "follow",
+                            "children": [
+                                {"condition": "target_visible"},
+                                {"action": "follow_target"},
+                            ],
+                        }
+                    },
+                    {
+                        "fallback": {
+                            "name": "find",
+                            "children": [
+                                {
+                                    "sequence": {
+                                        "name": "predict_and_look",
+                                        "children": [
+                                            {"condition": "prediction_available"},
+                                            {"action": "go_to_prediction"},
+                                            {"action": "look_around"},
+                                        ],
+                                    }
+                                },
+                                {"action": "waypoint_search"},
+                            ],
+                        }
+                    },
+                ],
+            }
+        }
+    )
+
+
+class BehaviorConfig(_Model):
+    """The behavior tree and its tick rate (§II-A); the default tree is the paper's Fig. 2."""
+
+    tick_hz: Positive = 10.0
+    tree: TreeNode = Field(default_factory=_paper_tree)
+
+
+# --------------------------------------------------------------------------------------------
+# scenario
+# --------------------------------------------------------------------------------------------
+
+
+def _route_stop_kind(value: Any) -> str | None:
+    if isinstance(value, str):
+        return "region"
+    if isinstance(value, (list, tuple)):
+        return "point"
+    return None
+
+
+RouteStop = Annotated[
+    Union[Annotated[Name, Tag("region")], Annotated[Point, Tag("point")]],  # noqa: UP007
+    Discriminator(
+        _route_stop_kind,
+        custom_error_type="route_stop",
+        custom_error_message="expected a region name or an [x, y] point",
+    ),
+]
+"""A stop of a person's route: the name of a region (its centre) or an ``[x, y]`` point."""
+
+
+class Clothes(_Model):
+    """Colours of a simulated person's clothes, RGB 0..255 (Algorithm 2 compares histograms)."""
+
+    upper: RGB
+    lower: RGB
+
+
+class Person(_Model):
+    """A simulated person: name, clothes, walking speed (m/s) and route."""
+
+    name: Name
+    clothes: Clothes
+    speed: Annotated[float, Field(ge=0.3, le=1.4), _NO_BOOL] = 0.8
+    route: Annotated[tuple[RouteStop, ...], Field(min_length=1)]
+    """Region names or [x, y] points, walked in order."""
+
+
+class ScenarioConfig(_Model):
+    """The simulator's episode: seed, the people, and which of them is the target."""
+
+    seed: Integer = 0
+    target: str | None = None
+    """The name of the person to follow: one of ``people``."""
+    people: tuple[Person, ...] = ()
+
+    @model_validator(mode="after")
+    def _names(self) -> ScenarioConfig:
+        issues: list[tuple[tuple[str | int, ...], str]] = []
+        seen: dict[str, int] = {}
+        for i, person in enumerate(self.people):
+            if person.name in seen:
+                issues.append(
+                    (
+                        ("people", i, "name"),
+                        f"duplicate person name {person.name!r} "
+                        f"(already used by people[{seen[person.name]}])",
+                    )
+                )
+            seen.setdefault(person.name, i)
+        if self.target is not None and self.target not in seen:
+            names = ", ".join(seen) or "none"
+            issues.append(
+                (
+                    ("target",),
+                    f"expected the name of one of the people ({names}), got {self.target!r}",
+                )
+            )
+        _raise_first(issues)
+        return self
+
+
+# --------------------------------------------------------------------------------------------
+# the mission
+# --------------------------------------------------------------------------------------------
+
+
+class Mission(_Model):
+    """A whole mission file. Only ``name`` and ``map.regions`` are required."""
+
+    name: Name
+    description: str | None = None
+    map: MapConfig
+    robot: RobotConfig = RobotConfig()
+    perception: PerceptionConfig = PerceptionConfig()
+    tracking: TrackingConfig = TrackingConfig()
+    belief: BeliefConfig = BeliefConfig()
+    prediction: PredictionConfig = PredictionConfig()
+    search: SearchConfig = SearchConfig()
+    behavior: BehaviorConfig = BehaviorConfig()
+    scenario: ScenarioConfig = ScenarioConfig()
+
+    @model_validator(mode="after")
+    def _places_exist(self) -> Mission:
+        """The robot starts inside the house; routes name existing regions or inside points."""
+        issues: list[tuple[tuple[str | int, ...], str]] = []
+        regions = [r.name for r in self.map.regions]
+        house = shapely.union_all([shapely.Polygon(r.polygon) for r in self.map.regions])
+        inside = house.buffer(TOLERANCE)
+        start = self.robot.start
+        if start is not None and not inside.covers(shapely.Point(start.x, start.y)):
+            issues.append(
+                (
+                    ("robot", "start"),
+                    f"expected a start inside the regions, got ({start.x:g}, {start.y:g})",
+                )
+            )
+        for i, person in enumerate(self.scenario.people):
+            for j, stop in enumerate(person.route):
+                loc = ("scenario", "people", i, "route", j)
+                if isinstance(stop, str):
+                    if stop not in regions:
+                        issues.append(
+                            (loc, f"unknown region {stop!r} (regions: {', '.join(regions)})")
+                        )
+                elif not inside.covers(shapely.Point(stop)):
+                    issues.append(
+                        (loc, f"expected a point inside the regions, got {_fmt_point(stop)}")
+                    )
+        _raise_first(issues)
+        return self
+
+    def layout(self) -> HouseLayout:
+        """The ``map`` section as plain values (:class:`pfctl.core.house.HouseLayout`)."""
+        return HouseLayout(
+            regions=tuple(
+                Region(name=r.name, polygon=tuple((float(x), float(y)) for x, y in r.polygon))
+                for r in self.map.regions
+            ),
+            doors=tuple(
+                Door(
+                    between=(d.between[0], d.between[1]),
+                    segment=(
+                        (float(d.segment[0][0]), float(d.segment[0][1])),
+                        (float(d.segment[1][0]), float(d.segment[1][1])),
+                    ),
+                )
+                for d in self.map.doors
+            ),
+            obstacles=tuple(
+                Obstacle(
+                    polygon=tuple((float(x), float(y)) for x, y in o.polygon),
+                    height=float(o.height),
+                    name=o.name,
+                )
+                for o in self.map.obstacles
+            ),
+        )
+
+    def start_pose(self) -> tuple[float, float, float]:
+        """``robot.start`` as ``(x, y, theta)``, or a point inside the first region if unset."""
+        start = self.robot.start
+        if start is not None:
+            return (start.x, start.y, start.theta)
+        point = shapely.Polygon(self.map.regions[0].polygon).representative_point()
+        return (float(point.x), float(point.y), 0.0)
+
+
+def dump_json_schema() -> dict[str, Any]:
+    """The JSON Schema of a mission file (what ``pfctl mission schema`` prints)."""
+    return Mission.model_json_schema()
+
+
+# --------------------------------------------------------------------------------------------
+# loading, and turning every failure into one line
+# --------------------------------------------------------------------------------------------
+
+
+def load_mission(path: str | os.PathLike[str]) -> Mission:
+    """Read and validate the mission at ``path``.
+
+    Raises:
+        MissionError: for anything wrong with the file, with a one-line message
+            ``<file>:<line>: <key.path>: <what was expected>``.
+    """
+    source = os.fspath(path)
+    file = Path(source)
+    if file.is_dir():
+        raise MissionError(f"{source}: is a directory, expected a mission YAML file")
+    try:
+        raw = file.read_bytes()
+    except FileNotFoundError:
+        raise MissionError(f"{source}: no such file") from None
+    except OSError as err:
+        raise MissionError(f"{source}: cannot read: {err.strerror or err}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = raw[: err.start].count(b"\n") + 1
+        raise MissionError(
+            f"{source}:{line}: not UTF-8 text (byte 0x{raw[err.start]:02x}); "
+            "save the mission as UTF-8"
+        ) from None
+    return loads_mission(text, source=source, base_dir=file.parent)
+
+
+def loads_mission(
+    text: str, *, source: str = "<string>", base_dir: str | os.PathLike[str] | None = None
+) -> Mission:
+    """Validate the mission YAML in ``text``; ``source`` names it in errors.
+
+    ``base_dir`` is where relative paths in the mission (``map.occupancy``) are resolved;
+    the current directory if None.
+
+    Raises:
+        MissionError: as :func:`load_mission`.
+    """
+    root, data = _parse_yaml(text, source)
+    if root is None or data is None:
+        raise MissionError(
+            f"{source}: the file is empty; expected a mission with at least 'name' and 'map'"
+        )
+    if not isinstance(data, dict):
+        raise MissionError(
+            f"{source}:{root.start_mark.line + 1}: expected a mapping of mission sections "
+            f"(name, map, ...) at the top level, got {_yaml_kind(data)}"
+        )
+    _check_duplicate_keys(root, source)
+    context = {"base_dir": Path(base_dir) if base_dir is not None else Path(".")}
+    try:
+        return Mission.model_validate(data, context=context)
+    except ValidationError as err:
+        raise MissionError(_format_validation_error(err, root, source)) from None
+    except RecursionError:
+        raise MissionError(f"{source}: the mission is nested too deeply") from None
+
+
+def _yaml_kind(value: Any) -> str:
+    if isinstance(value, list):
+        return "a list"
+    if isinstance(value, str):
+        return f"the string {_short(value)}"
+    return f"{type(value).__name__} {_short(value)}"
+
+
+def _one_line(text: str) -> str:
+    return " ".join(str(text).split())
+
+
+def _short(value: Any, limit: int = 40) -> str:
+    text = _one_line(repr(value))
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def _parse_yaml(text: str, source: str) -> tuple[yaml.Node | None, Any]:
+    """Compose the node graph (for line numbers) and construct the data from it, in one parse."""
+    loader = yaml.SafeLoader(text)
+    try:
+        root = loader.get_single_node()
+        data = loader.construct_document(root) if root is not None else None
+    except yaml.MarkedYAMLError as err:
+        mark = err.problem_mark or err.context_mark
+        where = f"{source}:{mark.line + 1}" if mark is not None else source
+        parts = [p for p in (err.context, err.problem) if p]
+        cmark, pmark = err.context_mark, err.problem_mark
+        if cmark is not None and pmark is not None and err.context and cmark.line != pmark.line:
+            parts[0] = f"{err.context} (line {cmark.line + 1})"
+        detail = _one_line(": ".join(parts) or "invalid YAML")
+        label = (
+            "YAML error"
+            if isinstance(err, yaml.constructor.ConstructorError)
+            else "YAML syntax error"
+        )
+        raise MissionError(f"{where}: {label}: {detail}") from None
+    except yaml.YAMLError as err:
+        raise MissionError(f"{source}: YAML syntax error: {_one_line(str(err))}") from None
+    except RecursionError:
+        raise MissionError(f"{source}: the YAML is nested too deeply") from None
+    finally:
+        loader.dispose()
+    return root, data
+
+
+def _format_loc(loc: Sequence[str | int]) -> str:
+    """``("map", "doors", 1, "between")`` -> ``map.doors[1].between``."""
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += f".{part}" if out else str(part)
+    return out
+
+
+def _check_duplicate_keys(root: yaml.Node, source: str) -> None:
+    """PyYAML keeps the last of two equal keys silently; a mission must not repeat a key."""
+    seen: set[int] = set()
+    stack: list[tuple[yaml.Node, tuple[str | int, ...]]] = [(root, ())]
+    while stack:
+        node, loc = stack.pop()
+        if id(node) in seen:
+            continue
+        seen.add(id(node))
+        if isinstance(node, yaml.MappingNode):
+            keys: dict[str, int] = {}
+            for key, value in node.value:
+                if isinstance(key, yaml.ScalarNode) and key.value != "<<":
+                    if key.value in keys:
+                        path = _format_loc((*loc, key.value))
+                        raise MissionError(
+                            f"{source}:{key.start_mark.line + 1}: {path}: duplicate key "
+                            f"(first on line {keys[key.value]})"
+                        )
+                    keys[key.value] = key.start_mark.line + 1
+                    stack.append((value, (*loc, key.value)))
+        elif isinstance(node, yaml.SequenceNode):
+            stack.extend((item, (*loc, i)) for i, item in enumerate(node.value))
+
+
+def _locate(root: yaml.Node, loc: Sequence[str | int]) -> tuple[tuple[str | int, ...], int]:
+    """Walk the node graph along ``loc``; the cleaned key path and the line of the deepest node.
+
+    Union tags that pydantic inserts into the path (``route[0].point``) are dropped: a string
+    step into a scalar or a list cannot be a key. Once a key is missing, the rest of the path is
+    kept as is. The line is the key's line when the last step was into a mapping.
+    """
+    node: yaml.Node | None = root
+    line = root.start_mark.line + 1
+    path: list[str | int] = []
+    for part in loc:
+        if node is None:
+            path.append(str(part) if isinstance(part, str) else part)
+        elif isinstance(node, yaml.MappingNode):
+            match = next(
+                (
+                    (k, v)
+                    for k, v in reversed(node.value)
+                    if isinstance(k, yaml.ScalarNode) and k.value == str(part)
+                ),
+                None,
+            )
+            path.append(str(part))
+            if match is None:
+                node = None
+            else:
+                line = match[0].start_mark.line + 1
+                node = match[1]
+        elif isinstance(part, str):
+            continue  # a union tag, not a key
+        elif isinstance(node, yaml.SequenceNode) and 0 <= part < len(node.value):
+            path.append(part)
+            node = node.value[part]
+            line = node.start_mark.line + 1
+        else:
+            path.append(part)
+            node = None
+    return tuple(path), line
+
+
+def _allowed_keys(loc: Sequence[str | int]) -> list[str] | None:
+    """The keys the model at ``loc`` accepts, found by walking the model types along the path."""
+    candidates: list[Any] = [Mission]
+    for part in loc:
+        following: list[Any] = []
+        for tp in candidates:
+            following.extend(_step_type(tp, part))
+        candidates = following
+    for tp in candidates:
+        for model in _models_in(tp):
+            return [f.alias or name for name, f in model.model_fields.items()]
+    return None
+
+
+def _models_in(tp: Any) -> Iterator[type[BaseModel]]:
+    """The pydantic models ``tp`` may be (through Annotated, Optional and unions)."""
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        yield tp
+        return
+    origin = get_origin(tp)
+    if origin is Annotated:
+        yield from _models_in(get_args(tp)[0])
+    elif origin is Union or type(tp).__name__ == "UnionType":
+        for arg in get_args(tp):
+            yield from _models_in(arg)
+
+
+def _step_type(tp: Any, part: str | int) -> list[Any]:
+    """The types one key-path step below ``tp``."""
+    origin = get_origin(tp)
+    if origin is Annotated:
+        return _step_type(get_args(tp)[0], part)
+    if origin is Union or type(tp).__name__ == "UnionType":
+        return [t for arg in get_args(tp) for t in _step_type(arg, part)]
+    if isinstance(tp, type) and issubclass(tp, BaseModel):
+        field = tp.model_fields.get(str(part))
+        return [field.annotation] if field is not None else []
+    if origin in (tuple, list) and isinstance(part, int):
+        args = get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return [args[0]]
+        return [args[part]] if part < len(args) else []
+    return []
+
+
+_MODEL_TYPE = re.compile(r"a valid dictionary or instance of \w+")
+_COUNT = re.compile(r"^\w+ should have at (least|most) (\d+) items? after validation, not (\d+)$")
+_BOUND = re.compile(r"^expected (greater|less) than( or equal to)? (\S+)$")
+_OPERATORS = {
+    ("greater", False): ">",
+    ("greater", True): ">=",
+    ("less", False): "<",
+    ("less", True): "<=",
+}
+
+
+def _got(value: Any) -> str:
+    """How an input reads in ``(got ...)``: short values verbatim, containers by their kind."""
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)}"
+    if isinstance(value, Mapping):
+        return "a mapping"
+    if value is None or isinstance(value, bool):
+        return {None: "null", True: "true", False: "false"}[value]
+    return _short(value)
+
+
+def _format_error(error: Mapping[str, Any], root: yaml.Node) -> tuple[int, str, int]:
+    """One pydantic error as ``(line, "key.path: message", further errors it stands for)``."""
+    loc = tuple(error["loc"])
+    ctx = error.get("ctx") or {}
+    kind = error["type"]
+    message = _one_line(error["msg"])
+    if kind == "mission":
+        loc = (*loc, *ctx.get("loc", ()))
+    path, line = _locate(root, loc)
+    more = int(ctx.get("more", 0)) if kind == "mission" else 0
+    if kind == "missing":
+        message = "required key is missing"
+    elif kind == "extra_forbidden":
+        allowed = _allowed_keys(loc[:-1])
+        message = "unknown key"
+        if allowed:
+            message += f" (expected one of: {', '.join(allowed)})"
+    elif kind == "invalid_key":
+        message = f"expected a string key, got {_short(error.get('input'))}"
+    else:
+        message = re.sub(r"^(Value error|Assertion failed), ", "", message)
+        message = _MODEL_TYPE.sub("a mapping", message)
+        message = message.replace("a valid tuple", "a list").replace(
+            "a valid dictionary", "a mapping"
+        )
+        if message.startswith("Input should be "):
+            message = "expected " + message[len("Input should be ") :]
+        count = _COUNT.match(message)
+        if count:
+            unit = "item" if count.group(2) == "1" else "items"
+            message = f"expected at {count.group(1)} {count.group(2)} {unit}, got {count.group(3)}"
+        bound = _BOUND.match(message)
+        if bound:
+            operator = _OPERATORS[(bound.group(1), bool(bound.group(2)))]
+            message = f"expected a value {operator} {bound.group(3)}"
+        if "detail" not in ctx and kind != "route_stop" and not count:
+            message += f" (got {_got(error.get('input'))})"
+    where = _format_loc(path)
+    return line, f"{where}: {message}" if where else message, more
+
+
+def _format_validation_error(err: ValidationError, root: yaml.Node, source: str) -> str:
+    """The first error in file order, as one line, with ``(+N more)`` when there are others."""
+    errors = err.errors()
+    # A list with a bad item is also "too short after validation": that one is noise.
+    errors = [
+        e
+        for e in errors
+        if e["type"] not in ("too_short", "too_long")
+        or not any(
+            len(o["loc"]) > len(e["loc"]) and o["loc"][: len(e["loc"])] == e["loc"] for o in errors
+        )
+    ]
+    formatted = [_format_error(e, root) for e in errors]
+    formatted.sort(key=lambda item: item[0])  # stable: equal lines keep pydantic's order
+    line, message, _ = formatted[0]
+    more = len(formatted) - 1 + sum(m for _, _, m in formatted)
+    suffix = f" (+{more} more)" if more else ""
+    return f"{source}:{line}: {message}{suffix}"
