@@ -17,12 +17,10 @@ failure leaves the old file, or no file, behind.
 
 from __future__ import annotations
 
-import contextlib
 import io
 import math
 import os
 import re
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -34,6 +32,7 @@ from ruamel.yaml.util import load_yaml_guess_indent
 
 from pfctl.core.house import Door, Region
 from pfctl.errors import UserError
+from pfctl.files import write_output
 
 #: Decimals of written coordinates (millimetres); fewer when the resolution allows.
 MAX_DECIMALS = 3
@@ -230,41 +229,6 @@ def render_regions(
     return out.getvalue()
 
 
-def atomic_write(path: str | os.PathLike[str], data: str | bytes) -> Path:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and ``os.replace``.
-
-    An existing file keeps its permission bits. On failure the temporary file is removed and a
-    :class:`UserError` names the file.
-    """
-    target = Path(path)
-    payload = data.encode("utf-8") if isinstance(data, str) else data
-    mode = None
-    with contextlib.suppress(OSError):
-        mode = target.stat().st_mode & 0o7777
-    tmp: str | None = None
-    try:
-        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(payload)
-            fh.flush()
-            os.fsync(fh.fileno())
-        if mode is not None:
-            os.chmod(tmp, mode)
-        else:
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, target)
-        tmp = None
-    except OSError as err:
-        raise UserError(f"{target}: cannot write: {err.strerror or err}") from None
-    finally:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
-    return target
-
-
 def write_regions(
     mission_path: str | os.PathLike[str],
     regions: Sequence[Region],
@@ -298,7 +262,7 @@ def write_regions(
         from pfctl.mission import loads_mission
 
         loads_mission(text, source=str(path), base_dir=path.parent)
-    return atomic_write(path, text)
+    return write_output(path, text)
 
 
-__all__ = ["atomic_write", "doors_yaml", "regions_yaml", "render_regions", "write_regions"]
+__all__ = ["doors_yaml", "regions_yaml", "render_regions", "write_regions"]

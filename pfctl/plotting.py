@@ -25,7 +25,7 @@ from shapely.geometry import Polygon
 
 from pfctl.core.grid import FREE, OCCUPIED
 from pfctl.core.house import HouseLayout
-from pfctl.mission_edit import atomic_write
+from pfctl.files import write_output
 
 XY = tuple[float, float]
 
@@ -184,7 +184,7 @@ def plot_map(
     fig = map_figure(grid, layout, region_graph, title)
     buf = io.BytesIO()
     fig.savefig(buf, format="png", bbox_inches="tight")
-    return atomic_write(path, buf.getvalue())
+    return write_output(path, buf.getvalue())
 
 
 __all__ = ["grid_rgb", "map_figure", "plot_map", "region_anchor", "region_graph_edges"]

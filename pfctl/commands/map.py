@@ -32,8 +32,9 @@ from pfctl.core.house import Door, HouseLayout, Region
 from pfctl.core.rooms import RoomParams, name_after, segment_rooms
 from pfctl.core.walls import rasterize_house
 from pfctl.errors import MissionError, UserError
+from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission, loads_mission
-from pfctl.mission_edit import atomic_write, render_regions
+from pfctl.mission_edit import render_regions
 
 app = typer.Typer(help="Maps: annotate regions and doors, render them.", no_args_is_help=True)
 
@@ -414,10 +415,10 @@ def annotate(
     console = _console()
     console.print(summary_table(layout, title=f"{source}: {len(regions)} regions"))
     if mission_text is not None and out is not None:
-        atomic_write(out, mission_text)
+        write_output(out, mission_text)
         console.print(f"wrote {out}")
     if png_data is not None and png is not None:
-        atomic_write(png, png_data)
+        write_output(png, png_data)
         console.print(f"wrote {png}")
 
 
@@ -456,7 +457,7 @@ def render(
     _prepare_parent(png, "--png")
     layout = src.layout
     title = src.mission.name if src.mission is not None else mission.name
-    atomic_write(png, _png_bytes(src.grid, layout, graph, title))
+    write_output(png, _png_bytes(src.grid, layout, graph, title))
     console = _console()
     if layout is not None:
         console.print(summary_table(layout, title=f"{mission}: {len(layout.regions)} regions"))

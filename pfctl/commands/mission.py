@@ -3,15 +3,14 @@
 from __future__ import annotations
 
 import json
-import os
 import sys
-import tempfile
 from pathlib import Path
 from typing import Annotated
 
 import typer
 
-from pfctl.errors import MissionError, UserError
+from pfctl.errors import MissionError
+from pfctl.files import write_output
 from pfctl.mission import Mission, dump_json_schema, load_mission
 
 app = typer.Typer(help="Check a mission file, or print its JSON Schema.", no_args_is_help=True)
@@ -63,28 +62,5 @@ def schema(
     if out is None:
         typer.echo(text, nl=False)
         return
-    write_atomically(out, text)
+    write_output(out, text)
     typer.echo(f"wrote {out}")
-
-
-def write_atomically(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file and a rename: all of it or nothing.
-
-    Raises:
-        UserError: if the file cannot be written (no such directory, no permission, ...).
-    """
-    directory = path.parent if str(path.parent) else Path(".")
-    tmp: str | None = None
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-        with os.fdopen(fd, "w", encoding="utf-8") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.replace(tmp, path)
-        tmp = None
-    except OSError as err:
-        raise UserError(f"{path}: cannot write: {err.strerror or err}") from None
-    finally:
-        if tmp is not None:
-            Path(tmp).unlink(missing_ok=True)

@@ -14,10 +14,8 @@ map_server format (YAML + PGM) and converted to and from nav_msgs/OccupancyGrid 
 
 from __future__ import annotations
 
-import contextlib
 import math
 import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,6 +25,8 @@ import numpy as np
 import yaml
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import entr
+
+from pfctl.core.atomic_files import atomic_write, atomic_write_all
 
 FREE = 0
 OCCUPIED = 1
@@ -583,21 +583,12 @@ class OccupancyGrid:
             "mode": "trinary",
         }
         text = yaml.safe_dump(meta, sort_keys=False, default_flow_style=None)
-        pgm_tmp = yaml_tmp = None
         try:
-            pgm_tmp = _write_temp(pgm_file, header + np.ascontiguousarray(pixels).tobytes())
-            yaml_tmp = _write_temp(yaml_file, text.encode("utf-8"))
-            os.replace(pgm_tmp, pgm_file)
-            pgm_tmp = None
-            os.replace(yaml_tmp, yaml_file)
-            yaml_tmp = None
+            atomic_write_all(
+                [(pgm_file, header + np.ascontiguousarray(pixels).tobytes()), (yaml_file, text)]
+            )
         except OSError as err:
             raise GridFileError(f"{yaml_file}: cannot write map: {err.strerror or err}") from err
-        finally:
-            for tmp in (pgm_tmp, yaml_tmp):
-                if tmp is not None:
-                    with contextlib.suppress(OSError):
-                        os.unlink(tmp)
         return yaml_file, pgm_file
 
     @classmethod
@@ -796,24 +787,4 @@ def write_pgm(path: str | os.PathLike[str], pixels: ArrayLike) -> None:
     if image.ndim != 2:
         raise ValueError(f"a PGM image is 2-D, got shape {image.shape}")
     header = f"P5\n{image.shape[1]} {image.shape[0]}\n255\n".encode("ascii")
-    target = Path(path)
-    tmp = _write_temp(target, header + image.tobytes())
-    try:
-        os.replace(tmp, target)
-    except OSError:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _write_temp(target: Path, payload: bytes) -> str:
-    """Write ``payload`` to a new temporary file beside ``target``; return its name."""
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    try:
-        with os.fdopen(fd, "wb") as handle:
-            handle.write(payload)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-    return tmp
+    atomic_write(path, header + image.tobytes())
