@@ -26,11 +26,6 @@ HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 
 
 @pytest.fixture(scope="module")
-def layout() -> HouseLayout:
-    return load_mission(HOUSE).layout()
-
-
-@pytest.fixture(scope="module")
 def segmentation(layout: HouseLayout):
     return segment_rooms(rasterize_house(layout, 0.05))
 

@@ -20,14 +20,8 @@ from pfctl.core.walls import (
     wall_footprint,
     wall_segments,
 )
-from pfctl.mission import load_mission
 
 HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
-
-
-@pytest.fixture(scope="module")
-def layout() -> HouseLayout:
-    return load_mission(HOUSE).layout()
 
 
 def _state_at(grid, x: float, y: float) -> int:

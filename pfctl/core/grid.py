@@ -162,22 +162,22 @@ class InverseSensorModel:
     @property
     def l_hit(self) -> float:
         """logit(p_hit): what a hit adds to a cell's log-odds (Eq. 1)."""
-        return math.log(self.p_hit / (1.0 - self.p_hit))
+        return float(logit(self.p_hit))
 
     @property
     def l_miss(self) -> float:
         """logit(p_miss): what a pass-through adds to a cell's log-odds (Eq. 1); negative."""
-        return math.log(self.p_miss / (1.0 - self.p_miss))
+        return float(logit(self.p_miss))
 
     @property
     def l_min(self) -> float:
         """logit(p_min), the lower clamp of the log-odds."""
-        return math.log(self.p_min / (1.0 - self.p_min))
+        return float(logit(self.p_min))
 
     @property
     def l_max(self) -> float:
         """logit(p_max), the upper clamp of the log-odds."""
-        return math.log(self.p_max / (1.0 - self.p_max))
+        return float(logit(self.p_max))
 
 
 class OccupancyGrid:
