@@ -14,7 +14,6 @@ from pfctl.core.frontiers import (
     frontier_map,
     frontiers_from_states,
     gradient_l1,
-    grid_states,
     trinary_map,
     utility,
 )
@@ -286,8 +285,10 @@ def test_fast_paths_agree_with_the_plain_definitions() -> None:
     rng = np.random.default_rng(11)
     p = rng.choice([0.02, 0.1, 0.3, 0.5, 0.6, 0.8, 0.98], size=(40, 50))
     grid = OccupancyGrid.from_probabilities(p, RES)
-    states = grid.states()
-    np.testing.assert_array_equal(grid_states(grid), states)
+    states = grid.states()  # thresholds the log-odds; the plain definition thresholds p:
+    prob = grid.prob()
+    plain_states = np.where(prob < 0.196, FREE, np.where(prob > 0.65, OCCUPIED, UNKNOWN))
+    np.testing.assert_array_equal(states, plain_states)
     # Eq. 2 evaluated at the candidates only == frontier_map over the whole map, thresholded.
     F = frontier_map(trinary_map(states), states == OCCUPIED, beta=1.0)
     for threshold in (0.1, 0.7, 1.2):

@@ -66,7 +66,6 @@ __all__ = [
     "frontier_map",
     "frontiers_from_states",
     "gradient_l1",
-    "grid_states",
     "trinary_map",
     "utility",
 ]
@@ -137,30 +136,6 @@ class FrontierCluster:
         return len(self.cells)
 
 
-def grid_states(
-    grid: OccupancyGrid,
-    free_thresh: float = FREE_THRESH,
-    occupied_thresh: float = OCCUPIED_THRESH,
-) -> NDArray[np.int8]:
-    """``grid.states(free_thresh, occupied_thresh)``, computed on the log-odds directly.
-
-    p < t ⇔ l < logit(t), so thresholding ``grid.logodds`` gives the same FREE/OCCUPIED/UNKNOWN
-    array without an exp() per cell (~5× faster on 400 × 400). Falls back to ``grid.states``
-    for grid-like objects without ``logodds``.
-    """
-    lo = getattr(grid, "logodds", None)
-    if lo is None:
-        return np.asarray(grid.states(free_thresh=free_thresh, occupied_thresh=occupied_thresh))
-    out = np.full(lo.shape, UNKNOWN, dtype=np.int8)
-    out[lo < _logit(free_thresh)] = FREE
-    out[lo > _logit(occupied_thresh)] = OCCUPIED
-    return out
-
-
-def _logit(p: float) -> float:
-    return float(np.log(p / (1.0 - p)))
-
-
 def find_frontiers(
     grid: OccupancyGrid,
     beta: float,
@@ -176,7 +151,7 @@ def find_frontiers(
     occupied_thresh)``; clusters are their 8-connected components of at least ``min_cells`` cells.
     Ties in size are broken by the first cell in row-major order, so the order is deterministic.
     """
-    states = grid_states(grid, free_thresh, occupied_thresh)
+    states = grid.states(free_thresh, occupied_thresh)
     return frontiers_from_states(states, grid.geometry, beta, threshold, min_cells)
 
 

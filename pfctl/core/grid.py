@@ -316,12 +316,13 @@ class OccupancyGrid:
         """FREE (0) where p < free_thresh, OCCUPIED (1) where p > occupied_thresh, else UNKNOWN.
 
         The paper's three cell values O = 1, F = 0, U = 0.5 (§II-C) are these states; the default
-        thresholds are those of ROS map_server.
+        thresholds are those of ROS map_server. Computed on the log-odds (p < t ⇔ l < logit(t)),
+        which spares an exp() per cell.
         """
-        p = self.prob()
-        out = np.full(p.shape, UNKNOWN, dtype=np.int8)
-        out[p < free_thresh] = FREE
-        out[p > occupied_thresh] = OCCUPIED
+        lo = self.logodds
+        out = np.full(lo.shape, UNKNOWN, dtype=np.int8)
+        out[lo < logit(free_thresh)] = FREE
+        out[lo > logit(occupied_thresh)] = OCCUPIED
         return out
 
     def entropy(self, base: float = 2.0) -> float:

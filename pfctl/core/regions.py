@@ -35,7 +35,6 @@ from pfctl.core.frontiers import (
     FrontierCluster,
     closest_point,
     frontiers_from_states,
-    grid_states,
 )
 from pfctl.core.grid import FREE_THRESH, OCCUPIED, OCCUPIED_THRESH, UNKNOWN, GridGeometry
 from pfctl.core.house import Door, HouseLayout
@@ -328,7 +327,7 @@ def waypoint_search(
     target_point = region_map.region_point(target) if target is not None else None
 
     geometry = grid.geometry
-    states = grid_states(grid, free_thresh, occupied_thresh)
+    states = grid.states(free_thresh, occupied_thresh)
     if confine_to_regions:
         states = np.where(region_map.inside_mask(geometry), states, np.int8(OCCUPIED))
     clusters = frontiers_from_states(states, geometry, beta, frontier_threshold, min_frontier_cells)
