@@ -263,3 +263,25 @@ def test_waypoint_search_ignores_frontiers_beyond_the_house(rmap: RegionMap) -> 
     assert not any(at_gap(confined)) and confined.reason == "frontier"
     assert confined.heading_region == "office"
     assert all(rmap.locate(g) is not None for g in confined.goals)
+
+
+def test_an_unseen_wall_between_regions_is_still_a_wall(rmap: RegionMap) -> None:
+    """The office is explored but its east wall (to the bedroom) is not: on the raw grid the office
+    cells along that wall are a frontier, and the straight way through the wall to the bedroom
+    makes it the best one. The region map knows the wall: only the bedroom door is a frontier."""
+    p = _house_probabilities(("bedroom",))
+    p[119:180, 119:121] = 0.5  # the wall x = 6 m between office and bedroom, unseen
+    grid = OccupancyGrid.from_probabilities(p, RES)
+    walk = _walk((6.0, 5.5), (8.5, 5.5))  # along the hall, toward the bedroom door
+    robot = (5.5, 7.5)  # in the office, next to that wall
+
+    raw = waypoint_search(grid, rmap, walk, robot, **SEARCH, confine_to_regions=False)
+    assert raw.heading_region == "bedroom" and 5.8 < raw.waypoint[0] < 6.0
+
+    confined = waypoint_search(grid, rmap, walk, robot, **SEARCH)
+    assert confined.reason == "frontier" and len(confined.clusters) == 1
+    x, y = confined.waypoint
+    assert 9.0 < x < 9.9 and 5.9 < y < 6.0  # the hall side of the bedroom door
+    # d(x, c) now runs out of the office door and along the hall: at least 0.5 m to the office
+    # door's east end (4.4, 6), then 4.6 m to the bedroom door's west end (9, 6).
+    assert -confined.utilities[0] > math.hypot(5.5 - 4.4, 7.5 - 6.0) + 4.6

@@ -39,6 +39,7 @@ from pfctl.core.frontiers import (
 from pfctl.core.grid import FREE_THRESH, OCCUPIED, OCCUPIED_THRESH, UNKNOWN, GridGeometry
 from pfctl.core.house import Door, HouseLayout
 from pfctl.core.paths import distance_fields, traversability
+from pfctl.core.walls import wall_mask
 
 if TYPE_CHECKING:
     from pfctl.core.grid import OccupancyGrid
@@ -99,7 +100,7 @@ class RegionMap:
                 graph.add_edge(a, b, doors=(door,))
             graph.edges[a, b].update(segment=door.segment, midpoint=mid, weight=weight)
         self.graph = graph
-        self._inside_masks: dict[GridGeometry, NDArray[np.bool_]] = {}
+        self._blocked_masks: dict[GridGeometry, NDArray[np.bool_]] = {}
 
     @property
     def names(self) -> list[str]:
@@ -150,20 +151,22 @@ class RegionMap:
             return ()
         return tuple(self.graph.edges[a, b]["doors"])
 
-    def inside_mask(self, geometry: GridGeometry) -> NDArray[np.bool_]:
-        """Cells of a grid with ``geometry`` that belong to the house: True where the cell centre
-        lies within one cell size of some region (so the wall lines on region boundaries and
-        the door openings count as inside). Computed once per geometry and cached; read-only.
+    def blocked_mask(self, geometry: GridGeometry) -> NDArray[np.bool_]:
+        """Cells of a grid with ``geometry`` that the region map alone says nobody can be in or
+        pass through: outside every region (more than a cell away), or on a region boundary that
+        is not a door — a wall (:func:`pfctl.core.walls.wall_mask`, two cells thick, one on each
+        side of the boundary line): regions are joined only by their doors (§II-B). Computed
+        once per geometry and cached; read-only.
         """
-        mask = self._inside_masks.get(geometry)
+        mask = self._blocked_masks.get(geometry)
         if mask is None:
             house = shapely.unary_union(list(self._polygons.values())).buffer(geometry.resolution)
             shapely.prepare(house)
-            rows, cols = np.mgrid[0 : geometry.height, 0 : geometry.width]
-            centres = geometry.cell_to_world(rows, cols)
-            mask = shapely.contains_xy(house, centres[..., 0], centres[..., 1])
+            centres = geometry.cell_to_world(*np.indices(geometry.shape))
+            inside = shapely.contains_xy(house, centres[..., 0], centres[..., 1])
+            mask = ~inside | wall_mask(self.layout, geometry, 2.0 * geometry.resolution)
             mask.flags.writeable = False
-            self._inside_masks[geometry] = mask
+            self._blocked_masks[geometry] = mask
         return mask
 
     def region_point(self, name: str) -> XY:
@@ -308,9 +311,11 @@ def waypoint_search(
        one from l*, confined to the known map and the two start points grown by
        ``paths.SEARCH_MARGIN`` = 2 m). With
        no l* at all the d(c, l*) term is dropped and c is the point closest to the robot.
-    With ``confine_to_regions`` (the default), cells outside every region count as obstacles:
-    the person is somewhere in the house, so frontiers outside it are not worth a look, and a
-    path must not cut through unexplored space beyond the walls (it would underestimate d).
+    With ``confine_to_regions`` (the default), the cells of :meth:`RegionMap.blocked_mask` count
+    as obstacles — outside every region, and the walls between regions: the person is somewhere
+    in the house, so frontiers outside it are not worth a look; a wall the robot has not seen yet
+    is still a wall, so the free cells along it are no frontier; and a path must not cut through
+    unexplored space beyond or across the walls (it would underestimate d).
 
     4. The way-point is the c of the best utility (first cluster on ties; clusters come largest
        first). Without any reachable cluster: l*'s point — moved to the nearest non-occupied
@@ -329,7 +334,7 @@ def waypoint_search(
     geometry = grid.geometry
     states = grid.states(free_thresh, occupied_thresh)
     if confine_to_regions:
-        states = np.where(region_map.inside_mask(geometry), states, np.int8(OCCUPIED))
+        states = np.where(region_map.blocked_mask(geometry), np.int8(OCCUPIED), states)
     clusters = frontiers_from_states(states, geometry, beta, frontier_threshold, min_frontier_cells)
     goals: list[XY] = []
     utilities: list[float] = []

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import shapely
+from numpy.typing import NDArray
 from shapely.geometry import LineString, Polygon
 from shapely.geometry.base import BaseGeometry
 from shapely.ops import unary_union
@@ -198,6 +199,25 @@ def _mark_lines(mask: np.ndarray, geometry: GridGeometry, segments: Iterable[Seg
         mask[rows[ok], cols[ok]] = True
 
 
+def wall_mask(
+    layout: HouseLayout, geometry: GridGeometry, thickness: float = 0.0
+) -> NDArray[np.bool_]:
+    """The cells of a grid with ``geometry`` that the house's walls cover.
+
+    The footprint of the walls at ``thickness`` (none when 0), plus every cell a wall segment
+    passes through, so the walls are closed at any resolution and door openings stay open.
+    """
+    mask = np.zeros(geometry.shape, dtype=bool)
+    if thickness > 0:
+        walls = wall_footprint(layout, thickness)
+        if not walls.is_empty:
+            shapely.prepare(walls)
+            centres = geometry.cell_to_world(*np.indices(geometry.shape))
+            mask |= shapely.intersects_xy(walls, centres[..., 0], centres[..., 1])
+    _mark_lines(mask, geometry, wall_segments(layout))
+    return mask
+
+
 def house_probabilities(
     layout: HouseLayout,
     resolution: float,
@@ -215,12 +235,7 @@ def house_probabilities(
     shapely.prepare(inside)
     free = shapely.intersects_xy(inside, x, y)
 
-    occupied = np.zeros(geometry.shape, dtype=bool)
-    walls = wall_footprint(layout, wall_thickness)
-    if not walls.is_empty:
-        shapely.prepare(walls)
-        occupied |= shapely.intersects_xy(walls, x, y)
-    _mark_lines(occupied, geometry, wall_segments(layout))
+    occupied = wall_mask(layout, geometry, wall_thickness)
     if include_obstacles and layout.obstacles:
         obstacles = unary_union([Polygon(o.polygon) for o in layout.obstacles])
         shapely.prepare(obstacles)
