@@ -729,7 +729,13 @@ class Person(_Model):
     clothes: Clothes
     speed: Annotated[float, Field(ge=0.3, le=1.4), _NO_BOOL] = 0.8
     route: Annotated[tuple[RouteStop, ...], Field(min_length=1)]
-    """Region names or [x, y] points, walked in order."""
+    """Region names or [x, y] points, walked in order; the person starts at the first."""
+    height: Annotated[float, Field(ge=1.2, le=2.1), _NO_BOOL] = 1.7
+    """Body height, metres (simulator)."""
+    pause_s: NonNegative = 2.0
+    """Mean pause at each intermediate stop of the route, seconds."""
+    loop: bool = False
+    """Walk the route again and again (back to the first stop); else stay at the last stop."""
 
 
 class ScenarioConfig(_Model):
@@ -739,6 +745,8 @@ class ScenarioConfig(_Model):
     target: str | None = None
     """The name of the person to follow: one of ``people``."""
     people: tuple[Person, ...] = ()
+    random_people: Annotated[int, Field(ge=0, le=20), _NO_BOOL] = 0
+    """Extra distractors with random clothes, speeds and looping routes drawn from ``seed``."""
 
     @model_validator(mode="after")
     def _names(self) -> ScenarioConfig:

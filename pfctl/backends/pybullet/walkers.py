@@ -1,0 +1,326 @@
+"""Kinematic people for the simulated house: routes through doors, gait, pauses (no pybullet).
+
+Each :class:`Walker` starts at the first stop of its route (``scenario.people[*].route``: a region
+name becomes a free point of that region, an ``[x, y]`` point stays as it is) and walks the legs
+between stops along paths planned on the static map for a person-sized disc, so people go through
+doors and around furniture. Speed ramps up and down smoothly (bounded acceleration, braking
+before a stop); at each intermediate stop the person pauses for about ``pause_s``. After the last
+stop a person stays there, or walks back to the first stop and starts again when ``loop``.
+
+The two legs are what a laser sees (the paper detects people by their legs, §II-E): cylinders of
+:data:`LEG_RADIUS` beside the body centre, swinging forward and back in opposite phase with a
+stride that grows with speed, and standing side by side when the person is still.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+import shapely
+
+from pfctl.core.planning import GridPlanner, NoPathError
+from pfctl.core.robot import PersonTruth
+from pfctl.mission import Mission, Person
+
+#: A person's footprint for planning, metres.
+PERSON_RADIUS = 0.25
+#: Radius of each leg cylinder, metres.
+LEG_RADIUS = 0.06
+#: Lateral distance between the legs' centres (hip width), metres.
+HIP_WIDTH = 0.2
+#: Walking acceleration and braking, m/s².
+ACCELERATION = 0.6
+#: Fastest turn of the body, rad/s.
+TURN_RATE = 3.0
+
+
+@dataclass(frozen=True)
+class WalkerClothes:
+    """Clothes colours, RGB 0..255."""
+
+    upper: tuple[int, int, int]
+    lower: tuple[int, int, int]
+
+
+@dataclass(frozen=True)
+class WalkerState:
+    """A person at one instant: pose, speed, looks and leg positions (map frame)."""
+
+    name: str
+    x: float
+    y: float
+    theta: float
+    speed: float
+    is_target: bool
+    height: float
+    clothes: WalkerClothes
+    legs: np.ndarray
+    """Rows ``[x, y, radius]`` of the two legs."""
+    paused: bool = False
+
+
+def _region_point(
+    planner: GridPlanner,
+    polygon: tuple[tuple[float, float], ...],
+    rng: np.random.Generator | None = None,
+) -> np.ndarray:
+    """A free point of the region: with ``rng``, a random free cell at least 0.3 m from
+    obstacles (so people sent to the same room spread out); without, the centroid if free, else
+    the free cell nearest to it.
+    """
+    poly = shapely.Polygon(polygon)
+    centre = np.array(poly.centroid.coords[0])
+    if rng is not None:
+        rows, cols = np.nonzero(planner.free & (planner.clearance >= PERSON_RADIUS + 0.3))
+        cells = planner.geometry.cell_to_world(rows, cols)
+        cand = cells[shapely.contains_xy(poly, cells[:, 0], cells[:, 1])]
+        if len(cand):
+            return cand[int(rng.integers(len(cand)))]
+    if planner.is_free(centre) and poly.contains(shapely.Point(centre)):
+        return centre
+    rows, cols = np.nonzero(planner.free)
+    cells = planner.geometry.cell_to_world(rows, cols)
+    inside = shapely.contains_xy(poly, cells[:, 0], cells[:, 1])
+    if not inside.any():
+        raise NoPathError("a region has no free point for a person")
+    cand = cells[inside]
+    return cand[int(np.argmin(np.linalg.norm(cand - centre, axis=1)))]
+
+
+class Walker:
+    """One simulated person walking a planned polyline; advance it with :meth:`step`."""
+
+    def __init__(
+        self,
+        name: str,
+        stops: list[np.ndarray],
+        planner: GridPlanner,
+        *,
+        speed: float,
+        clothes: WalkerClothes,
+        height: float = 1.7,
+        pause_s: float = 2.0,
+        loop: bool = False,
+        is_target: bool = False,
+        seed: int = 0,
+    ) -> None:
+        self.name = name
+        self.clothes = clothes
+        self.height = float(height)
+        self.is_target = is_target
+        self.cruise = float(speed)
+        self.pause_s = float(pause_s)
+        self.loop = loop
+        self._rng = np.random.default_rng(seed)
+        self.stops = [np.asarray(s, dtype=float) for s in stops]
+        legs = []
+        pairs = list(zip(self.stops[:-1], self.stops[1:], strict=True))
+        if loop and len(self.stops) > 1:
+            pairs.append((self.stops[-1], self.stops[0]))
+        for a, b in pairs:
+            legs.append(planner.plan(a, b))
+        self._legs_paths = legs
+        self._leg_index = 0
+        self._path = legs[0] if legs else self.stops[0][None]
+        self._s = 0.0  # distance walked along the current path
+        self._cum = self._cumulative(self._path)
+        self.x, self.y = (float(v) for v in self.stops[0])
+        self.theta = self._initial_heading()
+        self.speed = 0.0
+        self.phase = 0.0
+        self._pause_left = 0.0
+        self.done = not legs
+
+    @staticmethod
+    def _cumulative(path: np.ndarray) -> np.ndarray:
+        return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+
+    def _initial_heading(self) -> float:
+        if len(self._path) > 1:
+            d = self._path[1] - self._path[0]
+            return math.atan2(d[1], d[0])
+        return 0.0
+
+    def _point_at(self, s: float) -> tuple[np.ndarray, np.ndarray]:
+        """Position and unit direction at arc length ``s`` of the current path."""
+        cum = self._cum
+        i = int(np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(cum) - 2))
+        seg = self._path[i + 1] - self._path[i]
+        length = max(float(cum[i + 1] - cum[i]), 1e-12)
+        t = np.clip((s - cum[i]) / length, 0.0, 1.0)
+        return self._path[i] + seg * t, seg / length
+
+    def step(self, dt: float) -> None:
+        """Advance ``dt`` seconds: pause, or walk with bounded acceleration toward the next stop."""
+        if dt <= 0:
+            return
+        if self.done or self._pause_left > 0:
+            self._pause_left = max(self._pause_left - dt, 0.0)
+            self.speed = 0.0
+            self._settle_legs(dt)
+            return
+        remaining = float(self._cum[-1]) - self._s
+        brake = math.sqrt(max(2.0 * ACCELERATION * remaining, 0.0))
+        target = min(self.cruise, brake)
+        if target > self.speed:
+            self.speed = min(target, self.speed + ACCELERATION * dt)
+        else:
+            self.speed = max(target, self.speed - 2.0 * ACCELERATION * dt)
+        self.speed = max(self.speed, min(0.05, remaining / dt))  # never stall short of a stop
+        self._s = min(self._s + self.speed * dt, float(self._cum[-1]))
+        pos, direction = self._point_at(self._s)
+        self.x, self.y = float(pos[0]), float(pos[1])
+        want = math.atan2(direction[1], direction[0])
+        turn = (want - self.theta + math.pi) % (2 * math.pi) - math.pi
+        self.theta += float(np.clip(turn, -TURN_RATE * dt, TURN_RATE * dt))
+        self.theta = (self.theta + math.pi) % (2 * math.pi) - math.pi
+        self.phase = (self.phase + 2 * math.pi * self._cadence() * dt) % (2 * math.pi)
+        if self._s >= float(self._cum[-1]) - 1e-9:
+            self._arrive()
+
+    def _cadence(self) -> float:
+        """Gait cycles per second: two steps of :meth:`_stride` metres per cycle."""
+        return self.speed / (2.0 * self._stride()) if self.speed > 0 else 0.0
+
+    def _stride(self) -> float:
+        """Fore-aft swing amplitude of the legs (m), growing with speed (≈0.3 m at 0.8 m/s)."""
+        return min(0.1 + 0.25 * self.speed, 0.42)
+
+    def _settle_legs(self, dt: float) -> None:
+        """Bring the legs together when standing: the phase moves to the nearest 0 or π."""
+        near = round(self.phase / math.pi) * math.pi
+        self.phase += float(np.clip(near - self.phase, -8.0 * dt, 8.0 * dt))
+
+    def _arrive(self) -> None:
+        self.speed = 0.0
+        self._leg_index += 1
+        last = self._leg_index >= len(self._legs_paths)
+        if last and not self.loop:
+            self.done = True
+            return
+        self._leg_index %= len(self._legs_paths)
+        self._path = self._legs_paths[self._leg_index]
+        self._cum = self._cumulative(self._path)
+        self._s = 0.0
+        self._pause_left = self.pause_s * float(self._rng.uniform(0.5, 1.5))
+
+    @property
+    def paused(self) -> bool:
+        return self.done or self._pause_left > 0
+
+    def legs(self) -> np.ndarray:
+        """The two legs ``(2, 3)``: ``[x, y, LEG_RADIUS]`` in the map frame."""
+        c, s = math.cos(self.theta), math.sin(self.theta)
+        swing = 0.5 * self._stride() * math.sin(self.phase)
+        out = np.empty((2, 3))
+        for k, side in enumerate((1.0, -1.0)):
+            fwd = side * swing
+            lat = side * HIP_WIDTH / 2
+            out[k] = (self.x + c * fwd - s * lat, self.y + s * fwd + c * lat, LEG_RADIUS)
+        return out
+
+    @property
+    def state(self) -> WalkerState:
+        return WalkerState(
+            name=self.name,
+            x=self.x,
+            y=self.y,
+            theta=self.theta,
+            speed=self.speed,
+            is_target=self.is_target,
+            height=self.height,
+            clothes=self.clothes,
+            legs=self.legs(),
+            paused=self.paused,
+        )
+
+    def truth(self) -> PersonTruth:
+        return PersonTruth(self.name, self.x, self.y, self.theta, self.speed, self.is_target)
+
+
+def _stops(
+    mission: Mission, person: Person, planner: GridPlanner, rng: np.random.Generator
+) -> list[np.ndarray]:
+    layout = mission.layout()
+    out = []
+    for stop in person.route:
+        if isinstance(stop, str):
+            out.append(_region_point(planner, layout.region(stop).polygon, rng))
+        else:
+            p = planner.nearest_free(stop, max_distance=1.0)
+            if p is None:
+                raise NoPathError(f"{person.name}: route point {stop} is not free for a person")
+            out.append(np.asarray(p, dtype=float))
+    return out
+
+
+def _random_walkers(
+    mission: Mission, planner: GridPlanner, rng: np.random.Generator, taken: set[str]
+) -> list[Walker]:
+    """``scenario.random_people`` distractors: random free stops, clothes and speed."""
+    layout = mission.layout()
+    walkers = []
+    for i in range(mission.scenario.random_people):
+        name = f"walker_{i}"
+        while name in taken:
+            name += "_"
+        regions = rng.choice(len(layout.regions), size=3, replace=True)
+        stops = []
+        for r in regions:
+            stops.append(_region_point(planner, layout.regions[int(r)].polygon, rng))
+        clothes = WalkerClothes(
+            tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
+            tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
+        )
+        walkers.append(
+            Walker(
+                name,
+                stops,
+                planner,
+                speed=float(rng.uniform(0.5, 1.2)),
+                clothes=clothes,
+                height=float(rng.uniform(1.55, 1.9)),
+                pause_s=float(rng.uniform(1.0, 4.0)),
+                loop=True,
+                seed=int(rng.integers(2**31)),
+            )
+        )
+    return walkers
+
+
+def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
+    """The scenario's people (plus ``random_people`` distractors), deterministic for ``seed``.
+
+    ``planner`` may be the robot's: routes are planned with a copy for :data:`PERSON_RADIUS`.
+    Raises :class:`NoPathError` if a route cannot be walked.
+    """
+    if abs(planner.robot_radius - PERSON_RADIUS) > 1e-9:
+        planner = planner.with_radius(PERSON_RADIUS)
+    rng = np.random.default_rng(seed)
+    walkers = []
+    for person in mission.scenario.people:
+        clothes = WalkerClothes(
+            tuple(int(v) for v in person.clothes.upper),  # type: ignore[arg-type]
+            tuple(int(v) for v in person.clothes.lower),  # type: ignore[arg-type]
+        )
+        walkers.append(
+            Walker(
+                person.name,
+                _stops(mission, person, planner, rng),
+                planner,
+                speed=person.speed,
+                clothes=clothes,
+                height=person.height,
+                pause_s=person.pause_s,
+                loop=person.loop,
+                is_target=person.name == mission.scenario.target,
+                seed=int(rng.integers(2**31)),
+            )
+        )
+    walkers += _random_walkers(mission, planner, rng, {w.name for w in walkers})
+    return walkers
+
+
+__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerClothes", "WalkerState", "make_walkers"]
