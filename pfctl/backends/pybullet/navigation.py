@@ -1,0 +1,261 @@
+"""A MOVE_BASE equivalent for an omnidirectional base: plan on the static map, follow, re-plan.
+
+:class:`Navigator` plans with a :class:`~pfctl.core.planning.GridPlanner` (the static map
+inflated by the robot's radius) and follows the path with a pure-pursuit controller for a
+holonomic base: the command points at a carrot :data:`LOOKAHEAD` metres ahead on the path, at the
+speed limit, slowing down near the goal, while the base turns toward its direction of travel (and
+to the goal's heading at the end). It re-plans when obstacle points (laser returns that are not
+part of the static map) lie on the path ahead, or when the robot makes no progress for
+:data:`STUCK_TIME` seconds, marking those points as obstacles; after :data:`MAX_REPLANS`
+re-plans without success the goal is ABORTED. Pure numpy: no pybullet.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from pfctl.core.planning import GridPlanner, NoPathError
+from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
+
+#: Pure-pursuit carrot distance along the path, metres.
+LOOKAHEAD = 0.5
+#: How far ahead on the path (m) obstacle points are looked for.
+CHECK_AHEAD = 1.5
+#: Obstacle points closer than this to a static obstacle are the static map itself, metres.
+STATIC_MARGIN = 0.15
+#: No progress of at least PROGRESS metres for this long triggers a re-plan, seconds.
+STUCK_TIME = 4.0
+PROGRESS = 0.1
+#: Radius (m) of the disc each blocking point becomes in the re-planning map.
+BLOCKER_RADIUS = 0.1
+#: Re-plans allowed per goal before ABORTED.
+MAX_REPLANS = 5
+#: Wait (s) after a failed re-plan before trying again (a person may walk away).
+RETRY_WAIT = 1.0
+#: Least time (s) between two re-plans; meanwhile a blocked robot stands still.
+REPLAN_PERIOD = 1.0
+#: Progress (m) after which the re-plan count starts again (a long trip may meet many people).
+REPLAN_RESET = 1.5
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+class Navigator:
+    """Plan-and-follow navigation to one goal at a time (``actionlib`` status semantics)."""
+
+    def __init__(
+        self,
+        planner: GridPlanner,
+        max_linear_speed: float,
+        max_angular_speed: float,
+        goal_tolerance: float = 0.15,
+        yaw_tolerance: float = 0.2,
+    ) -> None:
+        self.planner = planner
+        self.max_linear_speed = float(max_linear_speed)
+        self.max_angular_speed = float(max_angular_speed)
+        self.goal_tolerance = float(goal_tolerance)
+        self.yaw_tolerance = float(yaw_tolerance)
+        self._status = NavStatus.IDLE
+        self.goal: Pose2D | None = None
+        self.path: np.ndarray | None = None
+        self.replans = 0
+        """Re-plans since the last REPLAN_RESET metres of progress (bounded by MAX_REPLANS)."""
+        self.total_replans = 0
+        """Re-plans for the current goal in all."""
+        self.reason = ""
+        self._best = math.inf
+        self._since_progress = 0.0
+        self._wait = 0.0
+        self._blockers = np.empty((0, 2))
+        self._since_replan = math.inf
+        self._rest_at_replan = math.inf
+
+    @property
+    def status(self) -> NavStatus:
+        return self._status
+
+    def start(self, goal: Pose2D, pose: Pose2D) -> None:
+        """Accept a new goal (a running one is PREEMPTED) and plan; ABORTED at once if no path."""
+        if self._status in (NavStatus.ACTIVE, NavStatus.PENDING):
+            self._status = NavStatus.PREEMPTED
+        self.goal = goal
+        self.replans = 0
+        self.total_replans = 0
+        self.reason = ""
+        self._blockers = np.empty((0, 2))
+        self._since_replan = math.inf
+        self._rest_at_replan = math.inf
+        self._status = NavStatus.PENDING
+        try:
+            self.path = self.planner.plan((pose.x, pose.y), (goal.x, goal.y))
+        except NoPathError as err:
+            self.path = None
+            self.reason = str(err)
+            self._status = NavStatus.ABORTED
+            return
+        self._reset_progress()
+        self._status = NavStatus.ACTIVE
+
+    def cancel(self) -> None:
+        """Drop the goal: PREEMPTED if it was running."""
+        if self._status in (NavStatus.ACTIVE, NavStatus.PENDING):
+            self._status = NavStatus.PREEMPTED
+        self.path = None
+
+    def _reset_progress(self) -> None:
+        self._best = math.inf
+        self._since_progress = 0.0
+        self._wait = 0.0
+
+    # ----------------------------------------------------------------------------------------
+
+    def _dynamic(self, points: np.ndarray | None) -> np.ndarray:
+        """The obstacle points that are not the static map (walls, furniture)."""
+        if points is None or len(points) == 0:
+            return np.empty((0, 2))
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        static_clear = self.planner.clearance_at(pts)
+        return pts[static_clear > STATIC_MARGIN]
+
+    def _remaining(self, xy: np.ndarray) -> tuple[float, int, np.ndarray]:
+        """Distance left along the path, the index of the nearest segment, the projection."""
+        assert self.path is not None
+        a, b = self.path[:-1], self.path[1:]
+        if len(a) == 0:
+            return float(np.linalg.norm(self.path[0] - xy)), 0, self.path[0]
+        d = b - a
+        L2 = np.maximum((d**2).sum(axis=1), 1e-12)
+        t = np.clip(((xy - a) * d).sum(axis=1) / L2, 0.0, 1.0)
+        proj = a + d * t[:, None]
+        i = int(np.argmin(np.linalg.norm(proj - xy, axis=1)))
+        seg_len = np.sqrt(L2)
+        rest = float(seg_len[i] * (1 - t[i]) + seg_len[i + 1 :].sum())
+        return rest, i, proj[i]
+
+    def _ahead(self, i: int, proj: np.ndarray, distance: float) -> np.ndarray:
+        """Points of the path from ``proj`` (on segment ``i``) up to ``distance`` metres on."""
+        assert self.path is not None
+        pts = [proj]
+        left = distance
+        cur = proj
+        for k in range(i + 1, len(self.path)):
+            seg = self.path[k] - cur
+            n = float(np.linalg.norm(seg))
+            if n >= left:
+                pts.append(cur + seg * (left / max(n, 1e-12)))
+                return np.array(pts)
+            pts.append(self.path[k])
+            left -= n
+            cur = self.path[k]
+        return np.array(pts)
+
+    def _blocked(self, ahead: np.ndarray, dynamic: np.ndarray) -> np.ndarray:
+        """The dynamic points within the robot's radius (+ margin) of the path ahead."""
+        if len(dynamic) == 0 or len(ahead) < 2:
+            return np.empty((0, 2))
+        a, b = ahead[:-1], ahead[1:]
+        d = b - a
+        L2 = np.maximum((d**2).sum(axis=1), 1e-12)
+        rel = dynamic[:, None, :] - a[None]
+        t = np.clip((rel * d[None]).sum(axis=2) / L2[None], 0.0, 1.0)
+        dist = np.linalg.norm(rel - d[None] * t[..., None], axis=2).min(axis=1)
+        return dynamic[dist < self.planner.robot_radius + 0.05]
+
+    def _replan(self, pose: Pose2D, blockers: np.ndarray) -> None:
+        """Plan again with ``blockers`` as extra obstacles; ABORTED after MAX_REPLANS."""
+        assert self.goal is not None
+        self.replans += 1
+        self.total_replans += 1
+        if self.replans > MAX_REPLANS:
+            self._status = NavStatus.ABORTED
+            self.reason = f"no way through after {MAX_REPLANS} re-plans"
+            return
+        if len(blockers):
+            self._blockers = np.vstack([self._blockers, blockers])[-400:]
+        planner = (
+            self.planner.with_obstacles(self._blockers, BLOCKER_RADIUS)
+            if len(self._blockers)
+            else self.planner
+        )
+        try:
+            self.path = planner.plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+        except NoPathError as err:
+            self.reason = str(err)
+            self._blockers = np.empty((0, 2))  # the blocker may move on: try the plain map next
+            self._wait = RETRY_WAIT
+        self._since_progress = 0.0
+        self._since_replan = 0.0
+        if self.path is not None:
+            self._rest_at_replan = self._remaining(np.array([pose.x, pose.y]))[0]
+
+    def update(self, pose: Pose2D, dt: float, obstacle_points: np.ndarray | None = None) -> Twist2D:
+        """The robot-frame command for this control period (STOP unless ACTIVE).
+
+        ``obstacle_points`` are map-frame points the robot currently senses (e.g.
+        ``LaserScan.points()``); those away from the static map that lie on the path ahead
+        trigger a re-plan around them.
+        """
+        if self._status is not NavStatus.ACTIVE or self.goal is None or self.path is None:
+            return STOP
+        if self._wait > 0:
+            self._wait -= dt
+            if self._wait <= 0:
+                self._replan(pose, np.empty((0, 2)))
+            return STOP
+        xy = np.array([pose.x, pose.y])
+        goal_xy = np.array([self.goal.x, self.goal.y])
+        to_goal = float(np.linalg.norm(goal_xy - xy))
+        if to_goal <= self.goal_tolerance:
+            yaw_err = _wrap(self.goal.theta - pose.theta)
+            if abs(yaw_err) <= self.yaw_tolerance:
+                self._status = NavStatus.SUCCEEDED
+                self.path = None
+                return STOP
+            wz = float(np.clip(1.5 * yaw_err, -self.max_angular_speed, self.max_angular_speed))
+            return Twist2D(0.0, 0.0, wz)
+        rest, i, proj = self._remaining(xy)
+        self._since_replan += dt
+        if rest < self._rest_at_replan - REPLAN_RESET:
+            self.replans = 0
+            self._rest_at_replan = rest
+        # progress watchdog
+        if rest < self._best - PROGRESS:
+            self._best = rest
+            self._since_progress = 0.0
+        else:
+            self._since_progress += dt
+        dynamic = self._dynamic(obstacle_points)
+        blockers = self._blocked(self._ahead(i, proj, CHECK_AHEAD), dynamic)
+        if len(blockers) and self._since_replan < REPLAN_PERIOD:
+            return STOP  # just re-planned and still blocked: wait for the next re-plan
+        if len(blockers) or self._since_progress > STUCK_TIME:
+            if not len(blockers) and len(dynamic):
+                blockers = dynamic[np.linalg.norm(dynamic - xy, axis=1) < 1.0]
+            self._replan(pose, blockers)
+            self._best = math.inf
+            if self._status is not NavStatus.ACTIVE or self._wait > 0:
+                return STOP
+            rest, i, proj = self._remaining(xy)
+        carrot = self._ahead(i, proj, LOOKAHEAD)[-1]
+        direction = carrot - xy
+        n = float(np.linalg.norm(direction))
+        if n < 1e-9:
+            direction, n = goal_xy - xy, to_goal
+        speed = min(self.max_linear_speed, 0.8 * rest + 0.03)
+        heading = math.atan2(direction[1], direction[0])
+        # turn toward the travel direction (or the goal heading at the end); slow down while
+        # the heading error is large so the base does not swing wide
+        target_yaw = self.goal.theta if rest < 0.4 else heading
+        yaw_err = _wrap(target_yaw - pose.theta)
+        wz = float(np.clip(1.5 * yaw_err, -self.max_angular_speed, self.max_angular_speed))
+        vx_map, vy_map = speed * direction / n
+        c, s = math.cos(pose.theta), math.sin(pose.theta)
+        return Twist2D(c * vx_map + s * vy_map, -s * vx_map + c * vy_map, wz)
+
+
+__all__ = ["Navigator"]

@@ -1,0 +1,136 @@
+"""Navigator with a kinematic omnidirectional robot in the shipped house."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import shapely
+
+from pfctl.backends.pybullet.navigation import Navigator
+from pfctl.core.planning import GridPlanner
+from pfctl.core.robot import NavStatus, Pose2D, Twist2D
+from pfctl.core.walls import rasterize_house, wall_footprint
+from pfctl.mission import Mission, load_mission
+
+HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
+DT = 0.1
+
+
+@pytest.fixture(scope="module")
+def mission() -> Mission:
+    return load_mission(HOUSE)
+
+
+@pytest.fixture(scope="module")
+def planner(mission: Mission) -> GridPlanner:
+    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
+    return GridPlanner(grid, mission.robot.radius)
+
+
+def _navigator(mission: Mission, planner: GridPlanner) -> Navigator:
+    return Navigator(planner, mission.robot.max_linear_speed, mission.robot.max_angular_speed)
+
+
+def _move(pose: Pose2D, cmd: Twist2D, dt: float) -> Pose2D:
+    """A perfect omnidirectional base: integrate the robot-frame twist."""
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    return Pose2D(
+        pose.x + (c * cmd.vx - s * cmd.vy) * dt,
+        pose.y + (s * cmd.vx + c * cmd.vy) * dt,
+        pose.theta + cmd.wz * dt,
+    )
+
+
+def _drive(nav: Navigator, pose: Pose2D, seconds: float, obstacles=None):
+    poses, cmds = [pose], []
+    for _ in range(int(seconds / DT)):
+        pts = obstacles(pose) if obstacles else None
+        cmd = nav.update(pose, DT, pts)
+        cmds.append(cmd)
+        pose = _move(pose, cmd, DT)
+        poses.append(pose)
+        if nav.status is not NavStatus.ACTIVE:
+            break
+    return poses, cmds
+
+
+def test_reaches_a_goal_in_another_room_within_limits(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    nav = _navigator(mission, planner)
+    start = Pose2D(1.0, 3.3, 0.0)
+    goal = Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office, two doors
+    nav.start(goal, start)
+    assert nav.status is NavStatus.ACTIVE
+    poses, cmds = _drive(nav, start, 200.0)
+    assert nav.status is NavStatus.SUCCEEDED
+    end = poses[-1]
+    assert end.distance_to(goal) <= nav.goal_tolerance
+    assert abs((end.theta - goal.theta + math.pi) % (2 * math.pi) - math.pi) <= nav.yaw_tolerance
+    lin = np.array([math.hypot(c.vx, c.vy) for c in cmds])
+    ang = np.array([abs(c.wz) for c in cmds])
+    assert lin.max() <= mission.robot.max_linear_speed + 1e-9
+    assert ang.max() <= mission.robot.max_angular_speed + 1e-9
+    assert lin.max() > 0.9 * mission.robot.max_linear_speed  # it really uses the speed
+    walls = wall_footprint(mission.layout(), mission.map.wall_thickness)
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert shapely.distance(walls, shapely.points(xy)).min() > mission.robot.radius - 0.03
+    assert nav.update(end, DT) == Twist2D()  # done: stands still
+
+
+def test_goal_in_a_wall_is_aborted_at_once(mission: Mission, planner: GridPlanner) -> None:
+    nav = _navigator(mission, planner)
+    nav.start(Pose2D(5.0, 3.0), Pose2D(1.0, 3.3))
+    assert nav.status is NavStatus.ABORTED
+    assert "obstacle" in nav.reason
+    assert nav.update(Pose2D(1.0, 3.3), DT) == Twist2D()
+
+
+def test_replans_around_a_blocker(mission: Mission, planner: GridPlanner) -> None:
+    """A person stands in the hall on the straight path; the laser sees its legs."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 5.0), Pose2D(8.0, 5.0)
+    blocker = np.array([6.0, 5.0])
+    ring = blocker + 0.2 * np.column_stack(
+        (np.cos(np.linspace(0, 2 * np.pi, 24)), np.sin(np.linspace(0, 2 * np.pi, 24)))
+    )
+    nav.start(goal, start)
+    first = nav.path.copy()
+    # the first plan goes straight through the person
+    assert np.abs(first[:, 1] - 5.0).max() < 0.3
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        near = np.linalg.norm(ring - (pose.x, pose.y), axis=1) < 4.0
+        return ring[near]
+
+    poses, _ = _drive(nav, start, 120.0, seen)
+    assert nav.status is NavStatus.SUCCEEDED
+    assert nav.total_replans >= 1
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert np.linalg.norm(xy - blocker, axis=1).min() > 0.2 + mission.robot.radius
+
+
+def test_fully_blocked_door_aborts_after_bounded_replans(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """The office door is closed by people standing in it: no way in, so ABORTED."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(3.9, 5.0, math.pi / 2), Pose2D(3.9, 7.5)
+    wall = np.column_stack((np.linspace(3.5, 4.4, 30), np.full(30, 5.8)))
+    nav.start(goal, start)
+    poses, _ = _drive(nav, start, 120.0, lambda pose: wall)
+    assert nav.status is NavStatus.ABORTED
+    assert nav.replans >= 1
+    assert max(p.y for p in poses) < 5.8 - mission.robot.radius
+
+
+def test_cancel_and_new_goal(mission: Mission, planner: GridPlanner) -> None:
+    nav = _navigator(mission, planner)
+    assert nav.status is NavStatus.IDLE
+    nav.start(Pose2D(3.0, 2.5), Pose2D(1.0, 3.3))
+    nav.cancel()
+    assert nav.status is NavStatus.PREEMPTED
+    assert nav.update(Pose2D(1.0, 3.3), DT) == Twist2D()
