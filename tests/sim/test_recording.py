@@ -71,3 +71,17 @@ def test_error_leaves_nothing(tmp_path: Path) -> None:
 def test_missing_bag_is_an_error(tmp_path: Path) -> None:
     with pytest.raises(RecordingError, match=BAG_NAME):
         read_episode(tmp_path)
+
+
+def test_episode_png(tmp_path: Path) -> None:
+    from pfctl.backends.pybullet.episode_plot import plot_episode
+    from pfctl.core.walls import rasterize_house
+    from pfctl.mission import load_mission
+
+    mission = load_mission(Path(__file__).resolve().parents[2] / "missions" / "house.yaml")
+    grid = rasterize_house(mission.layout(), 0.05, wall_thickness=mission.map.wall_thickness)
+    with EpisodeRecorder(tmp_path / "ep", "house") as rec:
+        for i in range(6):
+            rec.add(*_tick(i))
+    out = plot_episode(grid, mission.layout(), read_episode(tmp_path / "ep"), tmp_path / "e.png")
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
