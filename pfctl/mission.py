@@ -56,10 +56,12 @@ from pfctl.errors import MissionError
 __all__ = [
     "BehaviorConfig",
     "BeliefConfig",
+    "CameraConfig",
     "Clothes",
     "Composite",
     "Decorator",
     "DoorSpec",
+    "LaserConfig",
     "MapConfig",
     "Mission",
     "ObstacleSpec",
@@ -67,6 +69,7 @@ __all__ = [
     "PerceptionConfig",
     "Person",
     "Pose",
+    "PoseNoise",
     "PredictionConfig",
     "RegionSpec",
     "Repeat",
@@ -75,6 +78,7 @@ __all__ = [
     "ScenarioConfig",
     "SearchConfig",
     "SensorModel",
+    "SensorsConfig",
     "SvrParams",
     "Timeout",
     "TrackingConfig",
@@ -409,6 +413,85 @@ class RobotConfig(_Model):
     """rad/s."""
     start: Pose | None = None
     """Where the robot starts; None: a point inside the first region."""
+
+
+class LaserConfig(_Model):
+    """The base laser (HSR: Hokuyo UST-20LX); the simulator renders it, the HSR reports its own."""
+
+    rate_hz: Positive = 40.0
+    """Scans per second; also the simulator's physics sub-step."""
+    fov_deg: Annotated[float, Field(gt=0, le=360), _NO_BOOL] = 270.0
+    """Angular field of view, centred on the base's forward axis, degrees."""
+    resolution_deg: Annotated[float, Field(gt=0, le=10), _NO_BOOL] = 0.25
+    """Angle between two beams, degrees (270° at 0.25° gives 1081 beams)."""
+    range_min: Positive = 0.05
+    range_max: Positive = 20.0
+    noise_std: NonNegative = 0.01
+    """Std of the Gaussian range noise, metres."""
+    mount_x: Number = 0.167
+    """Forward offset of the laser from the base centre, metres."""
+    mount_height: Positive = 0.19
+    """Height of the scan plane above the floor, metres."""
+
+    @model_validator(mode="after")
+    def _ranges_ordered(self) -> LaserConfig:
+        if self.range_min >= self.range_max:
+            raise _fail(
+                ("range_max",),
+                f"expected range_max > range_min ({self.range_min:g}), got {self.range_max:g}",
+            )
+        return self
+
+
+class CameraConfig(_Model):
+    """The RGB-D camera on the head (HSR: Xtion PRO LIVE)."""
+
+    rate_hz: Positive = 10.0
+    """Frames per second."""
+    width: Annotated[int, Field(ge=16, le=1920), _NO_BOOL] = 320
+    height: Annotated[int, Field(ge=16, le=1080), _NO_BOOL] = 240
+    hfov_deg: Annotated[float, Field(gt=0, lt=180), _NO_BOOL] = 58.0
+    """Horizontal field of view, degrees."""
+    mount_height: Positive = 1.05
+    """Height of the head's pan/tilt pivot above the floor, metres."""
+    forward_offset: NonNegative = 0.1
+    """Distance of the optical centre ahead of the pivot, metres."""
+    range_min: Positive = 0.4
+    """Nearest measurable depth, metres (closer: ``inf``)."""
+    range_max: Positive = 8.0
+    """Farthest measurable depth, metres (farther: ``inf``)."""
+    depth_noise: NonNegative = 0.0
+    """Depth noise grows with the square of the distance: std = depth_noise · z², metres."""
+
+    @model_validator(mode="after")
+    def _ranges_ordered(self) -> CameraConfig:
+        if self.range_min >= self.range_max:
+            raise _fail(
+                ("range_max",),
+                f"expected range_max > range_min ({self.range_min:g}), got {self.range_max:g}",
+            )
+        return self
+
+
+class PoseNoise(_Model):
+    """Noise of the robot's own pose estimates (simulator)."""
+
+    localization_xy: NonNegative = 0.0
+    """Std of the map-frame position the robot reports (white, like AMCL's jitter), metres."""
+    localization_theta: NonNegative = 0.0
+    """Std of the map-frame heading the robot reports, radians."""
+    odometry_linear: NonNegative = 0.0
+    """Std of the odometry's translation error per metre travelled (it drifts)."""
+    odometry_angular: NonNegative = 0.0
+    """Std of the odometry's rotation error per radian turned (it drifts)."""
+
+
+class SensorsConfig(_Model):
+    """The robot's sensors: rates, fields of view, mounts and noise (the simulator uses them)."""
+
+    laser: LaserConfig = LaserConfig()
+    camera: CameraConfig = CameraConfig()
+    pose: PoseNoise = PoseNoise()
 
 
 class PerceptionConfig(_Model):
@@ -786,6 +869,7 @@ class Mission(_Model):
     description: str | None = None
     map: MapConfig
     robot: RobotConfig = RobotConfig()
+    sensors: SensorsConfig = SensorsConfig()
     perception: PerceptionConfig = PerceptionConfig()
     tracking: TrackingConfig = TrackingConfig()
     belief: BeliefConfig = BeliefConfig()

@@ -163,6 +163,8 @@ class Observation:
     """The newest RGB-D frame, or None if none has arrived since the previous observation."""
     collisions: int = 0
     """How many collisions the base has had so far (a robot can report bumper hits)."""
+    odometry: Pose2D | None = None
+    """The base's pose in the odom frame from wheel odometry (smooth, but it drifts), if any."""
 
 
 @dataclass(frozen=True)
