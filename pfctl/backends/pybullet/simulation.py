@@ -1,84 +1,174 @@
-"""SimRobot: the simulated house behind the Robot port (first cut: kinematic omni base).
+"""SimRobot: the simulated house behind the Robot port (``pfctl.core.robot.Robot``).
 
-Base motion is integrated kinematically and refused where the base disc (``robot.radius``) would
-overlap a wall or furniture outline (a collision is counted); the laser is :class:`FastLaser`;
-people are SIM-NAV's walkers; ``navigate`` uses SIM-NAV's :class:`Navigator`. No camera yet.
+One :meth:`SimRobot.step` advances one control period (``1 / behavior.tick_hz``) in sub-steps
+no longer than the laser's period. In each sub-step
+
+1. MOVE_BASE (:class:`~pfctl.backends.pybullet.navigation.Navigator`) turns an active goal into a
+   velocity command, using the newest scan to see blockers;
+2. the omnidirectional base moves kinematically with the command, clamped to the mission's limits
+   (``robot.max_linear_speed`` on the norm of (vx, vy), ``robot.max_angular_speed``); a move
+   that would bring the base disc (``robot.radius``) into a wall, a piece of furniture or a
+   person is refused, and each new contact counts one collision;
+3. the head's PD controller (:class:`~pfctl.backends.pybullet.head.HeadServo`) moves pan and tilt;
+4. the people walk their routes (:mod:`~pfctl.backends.pybullet.walkers`), waiting when the robot
+   stands in their way;
+5. sensors that are due fire at their own rates (``sensors.laser.rate_hz``,
+   ``sensors.camera.rate_hz``): the laser (:class:`FastLaser`, or ``rayTestBatch`` with
+   ``laser_model="bullet"``) and the RGB-D camera (``getCameraImage``); the PyBullet bodies of
+   the people and the robot are placed before anything is rendered or ray cast.
+
+:meth:`SimRobot.observe` hands out the newest scan and frame (each once), the head angles, the
+collision count, the map-frame pose as localisation reports it (true pose plus
+``sensors.pose.localization_*`` noise) and the odometry (integrated from the motion with
+``sensors.pose.odometry_*`` noise, so it drifts; its frame starts at the start pose).
+:meth:`SimRobot.ground_truth` is kept apart for metrics and recording. MOVE_BASE itself plans
+with the true pose. Everything random is drawn from the seed, so the same mission and seed give
+the same episode; ``gui`` opens PyBullet's window and ``realtime`` paces the steps to the clock.
 """
 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 import pybullet as p
 
-from pfctl.backends.pybullet.laser import FastLaser
+from pfctl.backends.pybullet.camera import SimCamera
+from pfctl.backends.pybullet.head import HeadServo
+from pfctl.backends.pybullet.laser import BulletLaser, FastLaser, LaserSpec
 from pfctl.backends.pybullet.navigation import Navigator
-from pfctl.backends.pybullet.walkers import make_walkers
+from pfctl.backends.pybullet.people_bodies import PeopleBodies
+from pfctl.backends.pybullet.robot_body import RobotBody
+from pfctl.backends.pybullet.walkers import Walker, make_walkers
 from pfctl.backends.pybullet.world import build_world
 from pfctl.core.planning import GridPlanner
 from pfctl.core.robot import (
+    STOP,
     GroundTruth,
-    HeadState,
     HeadTarget,
     LaserScan,
     NavStatus,
     Observation,
     Pose2D,
+    RgbdFrame,
     Twist2D,
 )
-from pfctl.core.walls import rasterize_house
+from pfctl.core.walls import house_bounds, rasterize_house
 from pfctl.mission import Mission
 
+#: Radius of a person's body for contacts with the robot, metres (the torso's half width).
+PERSON_CONTACT_RADIUS = 0.2
+#: Extra room a walking person leaves the robot, metres.
+PERSON_COURTESY = 0.15
+#: Shortest sub-step rate when the laser is slow, Hz.
+MIN_SUBSTEP_HZ = 20.0
 
-@dataclass
+
+@dataclass(frozen=True)
 class SimOptions:
-    """Simulator options (seed, window, pacing, laser model, camera)."""
+    """How to run the simulator (the mission says what to simulate)."""
 
-    seed: int = 0
+    seed: int | None = None
+    """Seed of everything random; None: the mission's ``scenario.seed``."""
     gui: bool = False
+    """Open PyBullet's window (default: headless, ``p.DIRECT``)."""
     realtime: bool = False
-    laser_model: str = "fast"
-    camera: bool = False
-    laser_hz: float = 40.0
+    """Pace the steps to the wall clock (default: as fast as the CPU allows)."""
+    laser_model: Literal["fast", "bullet"] = "fast"
+    """``fast``: vectorised 2-D ray casting; ``bullet``: PyBullet's ``rayTestBatch``."""
+    camera: bool = True
+    """Render the RGB-D camera (about 15 ms a frame at 320x240)."""
 
 
-def _seg_dist(xy: np.ndarray, segs: np.ndarray) -> float:
+def segment_distance(xy: np.ndarray, segs: np.ndarray) -> float:
+    """Distance from the point ``xy`` to the nearest segment row ``[x0, y0, x1, y1]``."""
+    if len(segs) == 0:
+        return math.inf
     a, b = segs[:, :2], segs[:, 2:]
     e = b - a
     t = np.clip(np.sum((xy - a) * e, axis=1) / np.maximum(np.sum(e * e, axis=1), 1e-12), 0, 1)
-    return float(np.min(np.hypot(*(a + t[:, None] * e - xy).T))) if len(segs) else math.inf
+    return float(np.min(np.hypot(*(a + t[:, None] * e - xy).T)))
+
+
+def compose(pose: Pose2D, dx: float, dy: float, dtheta: float) -> Pose2D:
+    """``pose`` moved by ``(dx, dy)`` in its own frame and turned by ``dtheta``."""
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    theta = math.atan2(math.sin(pose.theta + dtheta), math.cos(pose.theta + dtheta))
+    return Pose2D(pose.x + c * dx - s * dy, pose.y + s * dx + c * dy, theta)
 
 
 class SimRobot:
-    """The simulated HSR-like robot in the house (``pfctl.core.robot.Robot``)."""
+    """The simulated HSR-like robot in the house (implements ``pfctl.core.robot.Robot``)."""
 
     def __init__(self, mission: Mission, options: SimOptions | None = None) -> None:
-        self.mission, self.options = mission, options or SimOptions()
-        self._client = p.connect(p.GUI if self.options.gui else p.DIRECT)
-        self.world = build_world(self._client, mission)
-        rc = mission.robot
-        self.laser = FastLaser(self.world.scene.segments, seed=self.options.seed)
-        grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
-        self.planner = GridPlanner(grid, rc.radius)
-        self.people = make_walkers(mission, self.planner, self.options.seed)
+        self.mission = mission
+        self.options = options or SimOptions()
+        self.seed = mission.scenario.seed if self.options.seed is None else self.options.seed
+        rc, sensors = mission.robot, mission.sensors
+        self.static_map = rasterize_house(
+            mission.layout(), mission.map.resolution, mission.map.wall_thickness
+        )
+        self.planner = GridPlanner(self.static_map, rc.radius)
+        self.people: list[Walker] = make_walkers(mission, self.planner, self.seed)
         self.navigator = Navigator(self.planner, rc.max_linear_speed, rc.max_angular_speed)
-        if rc.start is not None:
-            self.pose = Pose2D(float(rc.start.x), float(rc.start.y), float(rc.start.theta))
-        else:
-            c = np.mean(np.array(mission.layout().regions[0].polygon), axis=0)
-            self.pose = Pose2D(float(c[0]), float(c[1]), 0.0)
+        self.laser_spec = LaserSpec.from_config(sensors.laser)
+        rngs = [np.random.default_rng([self.seed, k]) for k in range(4)]
+        laser_seed, camera_seed = (int(r.integers(2**31)) for r in rngs[:2])
+        self._pose_rng, self._odom_rng = rngs[2], rngs[3]
+        self._client = p.connect(p.GUI if self.options.gui else p.DIRECT)
+        self._closed = False
+        try:
+            self.world = build_world(self._client, mission)
+            self.people_bodies = PeopleBodies(self._client, self.people, seed=self.seed)
+            self.robot_body = RobotBody(self._client, rc.radius, sensors.camera.mount_height)
+            self.laser: FastLaser | BulletLaser = (
+                BulletLaser(self._client, self.laser_spec, laser_seed)
+                if self.options.laser_model == "bullet"
+                else FastLaser(self.world.scene.segments, self.laser_spec, laser_seed, True)
+            )
+            self.camera = (
+                SimCamera(self._client, sensors.camera, camera_seed)
+                if self.options.camera
+                else None
+            )
+            if self.options.gui:
+                self._setup_window()
+        except BaseException:
+            p.disconnect(self._client)
+            raise
+        self.pose = Pose2D(*mission.start_pose())
+        self.odometry = Pose2D(0.0, 0.0, 0.0)
+        self.head = HeadServo(rc)
+        period = 1.0 / mission.behavior.tick_hz
+        rate = max(sensors.laser.rate_hz, MIN_SUBSTEP_HZ)
+        self.substeps = max(1, math.ceil(period * rate - 1e-9))
+        """Sub-steps per control period: none longer than the laser's period."""
+        self.substep = period / self.substeps
         self.time, self.collisions = 0.0, 0
-        self.head, self._head_target = HeadState(), HeadTarget()
-        self._cmd, self._navigating, self._scan = Twist2D(), False, None
-        self._next_scan, self._closed = 0.0, False
+        self._ticks = 0
+        self._cmd = STOP
+        self._navigating = False
+        self._in_contact = False
+        self._scan: LaserScan | None = None
+        self._scan_points: np.ndarray | None = None
+        self._frame: RgbdFrame | None = None
+        self._next_scan = 0.0
+        self._next_frame = 0.0
+        self._wall_start: float | None = None
+        self._sense()  # the first scan and frame exist before the first step
+
+    # -- context manager ----------------------------------------------------------------------
 
     def __enter__(self) -> SimRobot:
         return self
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    # -- the Robot port -------------------------------------------------------------------------
 
     def clamp(self, t: Twist2D) -> Twist2D:
         """The command within the mission's linear (vx, vy norm) and angular limits."""
@@ -88,82 +178,190 @@ class SimRobot:
         wz = max(-rc.max_angular_speed, min(rc.max_angular_speed, t.wz))
         return Twist2D(t.vx * k, t.vy * k, wz)
 
+    @property
+    def commanded(self) -> Twist2D:
+        """The base velocity being executed (after clamping)."""
+        return self._cmd
+
     def command(self, base: Twist2D, head: HeadTarget | None = None) -> None:
         if self._navigating:
             self.navigator.cancel()
             self._navigating = False
         self._cmd = self.clamp(base)
         if head is not None:
-            self._head_target = head
+            self.head.set_target(head)
+
+    def point_head(self, head: HeadTarget) -> None:
+        """Move the head only (also while navigating)."""
+        self.head.set_target(head)
 
     def navigate(self, goal: Pose2D) -> None:
         self.navigator.start(goal, self.pose)
-        self._navigating = True
+        self._navigating = self.navigator.status is NavStatus.ACTIVE
+        if not self._navigating:
+            self._cmd = STOP
 
     def nav_status(self) -> NavStatus:
         return self.navigator.status
 
     def cancel(self) -> None:
         self.navigator.cancel()
-        self._navigating, self._cmd = False, Twist2D()
+        self._navigating, self._cmd = False, STOP
+
+    def step(self) -> None:
+        """Advance one control period ``1 / behavior.tick_hz``."""
+        if self._closed:
+            raise RuntimeError("the simulator is closed")
+        dt = self.substep
+        for _ in range(self.substeps):
+            if self._navigating:
+                self._cmd = self.clamp(self.navigator.update(self.pose, dt, self._scan_points))
+                if self.navigator.status is not NavStatus.ACTIVE:
+                    self._navigating = False
+            self._move(dt)
+            self.head.update(dt)
+            clear = self.mission.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
+            for walker in self.people:
+                walker.step(dt, keep_clear=(self.pose.x, self.pose.y, clear))
+            self._ticks += 1
+            self.time = self._ticks * dt
+            self._sense()
+        if self.options.gui:
+            self._sync_bodies()
+        if self.options.realtime:
+            self._pace()
+
+    def observe(self) -> Observation:
+        scan, frame = self._scan, self._frame
+        self._scan = self._frame = None
+        return Observation(
+            stamp=self.time,
+            pose=self._localized(),
+            head=self.head.state,
+            scan=scan,
+            rgbd=frame,
+            collisions=self.collisions,
+            odometry=self.odometry,
+        )
+
+    def ground_truth(self) -> GroundTruth:
+        """The truth now (for metrics and recording; never for the follower's decisions)."""
+        head = self.head.state
+        return GroundTruth(
+            stamp=self.time,
+            robot=self.pose,
+            people=tuple(w.truth() for w in self.people),
+            command=self._cmd,
+            collisions=self.collisions,
+            extra={"head_pan": head.pan, "head_tilt": head.tilt},
+        )
+
+    def close(self) -> None:
+        """Stop the base, drop the goal and release PyBullet; safe to call twice."""
+        self._cmd = STOP
+        self._navigating = False
+        if not self._closed:
+            self._closed = True
+            self.people_bodies.close()
+            p.disconnect(self._client)
+
+    # -- internals ---------------------------------------------------------------------------------
+
+    def _blocked(self, x: float, y: float) -> bool:
+        r = self.mission.robot.radius
+        if segment_distance(np.array([x, y]), self.world.scene.segments) <= r:
+            return True
+        reach = r + PERSON_CONTACT_RADIUS
+        return any(math.hypot(x - w.x, y - w.y) <= reach for w in self.people)
+
+    def _move(self, dt: float) -> None:
+        v = self._cmd
+        dx, dy, dth = v.vx * dt, v.vy * dt, v.wz * dt
+        target = compose(self.pose, dx, dy, dth)
+        contact = False
+        if dx or dy:
+            contact = self._blocked(target.x, target.y)
+            if contact:
+                dx = dy = 0.0
+                target = Pose2D(self.pose.x, self.pose.y, target.theta)
+        if contact and not self._in_contact:
+            self.collisions += 1
+        self._in_contact = contact
+        self.pose = target
+        self._odometry_step(dx, dy, dth)
+
+    def _odometry_step(self, dx: float, dy: float, dth: float) -> None:
+        noise = self.mission.sensors.pose
+        if noise.odometry_linear > 0 and (dx or dy):
+            k = noise.odometry_linear * math.sqrt(math.hypot(dx, dy))
+            dx += k * float(self._odom_rng.normal())
+            dy += k * float(self._odom_rng.normal())
+        if noise.odometry_angular > 0 and dth:
+            dth += noise.odometry_angular * math.sqrt(abs(dth)) * float(self._odom_rng.normal())
+        if dx or dy or dth:
+            self.odometry = compose(self.odometry, dx, dy, dth)
+
+    def _localized(self) -> Pose2D:
+        noise = self.mission.sensors.pose
+        if noise.localization_xy == 0 and noise.localization_theta == 0:
+            return self.pose
+        e = self._pose_rng.normal(size=3)
+        theta = self.pose.theta + noise.localization_theta * float(e[2])
+        return Pose2D(
+            self.pose.x + noise.localization_xy * float(e[0]),
+            self.pose.y + noise.localization_xy * float(e[1]),
+            math.atan2(math.sin(theta), math.cos(theta)),
+        )
 
     def _legs(self) -> np.ndarray:
         if not self.people:
             return np.empty((0, 3))
-        return np.vstack([w.state.legs for w in self.people])
+        return np.vstack([w.legs() for w in self.people])
 
-    def _move(self, dt: float) -> None:
-        c, s = math.cos(self.pose.theta), math.sin(self.pose.theta)
-        v = self._cmd
-        x = self.pose.x + (c * v.vx - s * v.vy) * dt
-        y = self.pose.y + (s * v.vx + c * v.vy) * dt
-        free = _seg_dist(np.array([x, y]), self.world.scene.segments) > self.mission.robot.radius
-        people = [w.state for w in self.people]
-        free = free and all(
-            math.hypot(x - q.x, y - q.y) > self.mission.robot.radius + 0.2 for q in people
+    def _sync_bodies(self) -> None:
+        self.people_bodies.sync()
+        self.robot_body.sync(self.pose, self.head.state)
+
+    def _sense(self) -> None:
+        """Fire the laser and the camera if they are due."""
+        eps = 1e-9
+        synced = False
+        if self.time >= self._next_scan - eps:
+            if isinstance(self.laser, BulletLaser):
+                self._sync_bodies()
+                synced = True
+            self._scan = self.laser.scan(self.pose, self._legs(), self.time)
+            self._scan_points = self._scan.points()
+            period = 1.0 / self.mission.sensors.laser.rate_hz
+            while self._next_scan <= self.time + eps:
+                self._next_scan += period
+        if self.camera is not None and self.time >= self._next_frame - eps:
+            if not synced:
+                self._sync_bodies()
+            self._frame = self.camera.render(self.pose, self.head.state, self.time)
+            period = 1.0 / self.mission.sensors.camera.rate_hz
+            while self._next_frame <= self.time + eps:
+                self._next_frame += period
+
+    def _pace(self) -> None:
+        now = time.perf_counter()
+        if self._wall_start is None:
+            self._wall_start = now - self.time
+        ahead = self.time - (now - self._wall_start)
+        if ahead > 0:
+            time.sleep(ahead)
+
+    def _setup_window(self) -> None:
+        c = self._client
+        p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
+        x0, y0, x1, y1 = house_bounds(self.mission.layout())
+        p.resetDebugVisualizerCamera(
+            cameraDistance=0.9 * max(x1 - x0, y1 - y0),
+            cameraYaw=0.0,
+            cameraPitch=-65.0,
+            cameraTargetPosition=((x0 + x1) / 2, (y0 + y1) / 2, 0.0),
+            physicsClientId=c,
         )
-        if not free:
-            moving = math.hypot(v.vx, v.vy) > 0
-            self.collisions += int(moving)
-            x, y = self.pose.x, self.pose.y
-        self.pose = Pose2D(x, y, self.pose.theta + v.wz * dt)
-        rc = self.mission.robot
-        step = rc.head_max_speed * dt
-        pan = min(max(self._head_target.pan, rc.head_pan_limits[0]), rc.head_pan_limits[1])
-        tilt = min(max(self._head_target.tilt, rc.head_tilt_limits[0]), rc.head_tilt_limits[1])
-        self.head = HeadState(
-            self.head.pan + max(-step, min(step, pan - self.head.pan)),
-            self.head.tilt + max(-step, min(step, tilt - self.head.tilt)),
-        )
 
-    def step(self) -> None:
-        """Advance one control period ``1 / tick_hz`` at the laser rate."""
-        period = 1.0 / self.mission.behavior.tick_hz
-        dt = 1.0 / self.options.laser_hz
-        end = self.time + period
-        while self.time < end - 1e-9:
-            if self._navigating:
-                pts = self._scan.points() if self._scan is not None else None
-                self._cmd = self.clamp(self.navigator.update(self.pose, dt, pts))
-            self._move(dt)
-            for w in self.people:
-                w.step(dt)
-            self.time += dt
-            if self.time >= self._next_scan - 1e-9:
-                self._scan = self.laser.scan(self.pose, self._legs(), self.time)
-                self._next_scan += dt
 
-    def observe(self) -> Observation:
-        scan: LaserScan | None = self._scan
-        self._scan = None
-        return Observation(self.time, self.pose, self.head, scan, None, self.collisions)
-
-    def ground_truth(self) -> GroundTruth:
-        people = tuple(w.truth() for w in self.people)
-        return GroundTruth(self.time, self.pose, people, self._cmd, self.collisions)
-
-    def close(self) -> None:
-        if not self._closed:
-            self._closed = True
-            self._cmd = Twist2D()
-            p.disconnect(self._client)
+__all__ = ["SimOptions", "SimRobot", "compose", "segment_distance"]

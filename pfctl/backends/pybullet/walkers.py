@@ -152,8 +152,13 @@ class Walker:
         t = np.clip((s - cum[i]) / length, 0.0, 1.0)
         return self._path[i] + seg * t, seg / length
 
-    def step(self, dt: float) -> None:
-        """Advance ``dt`` seconds: pause, or walk with bounded acceleration toward the next stop."""
+    def step(self, dt: float, keep_clear: tuple[float, float, float] | None = None) -> None:
+        """Advance ``dt`` seconds: pause, or walk with bounded acceleration toward the next stop.
+
+        ``keep_clear`` ``(x, y, distance)``: an obstacle the person will not walk into (the
+        robot). A step that would end closer than ``distance`` to it, and closer than now, is
+        not taken: the person stands and waits, as people do when a robot is in their way.
+        """
         if dt <= 0:
             return
         if self.done or self._pause_left > 0:
@@ -165,12 +170,20 @@ class Walker:
         brake = math.sqrt(max(2.0 * ACCELERATION * remaining, 0.0))
         target = min(self.cruise, brake)
         if target > self.speed:
-            self.speed = min(target, self.speed + ACCELERATION * dt)
+            speed = min(target, self.speed + ACCELERATION * dt)
         else:
-            self.speed = max(target, self.speed - 2.0 * ACCELERATION * dt)
-        self.speed = max(self.speed, min(0.05, remaining / dt))  # never stall short of a stop
-        self._s = min(self._s + self.speed * dt, float(self._cum[-1]))
-        pos, direction = self._point_at(self._s)
+            speed = max(target, self.speed - 2.0 * ACCELERATION * dt)
+        speed = max(speed, min(0.05, remaining / dt))  # never stall short of a stop
+        s = min(self._s + speed * dt, float(self._cum[-1]))
+        pos, direction = self._point_at(s)
+        if keep_clear is not None:
+            ox, oy, clear = keep_clear
+            after = math.hypot(pos[0] - ox, pos[1] - oy)
+            if after < clear and after < math.hypot(self.x - ox, self.y - oy):
+                self.speed = 0.0
+                self._settle_legs(dt)
+                return
+        self.speed, self._s = speed, s
         self.x, self.y = float(pos[0]), float(pos[1])
         want = math.atan2(direction[1], direction[0])
         turn = (want - self.theta + math.pi) % (2 * math.pi) - math.pi
