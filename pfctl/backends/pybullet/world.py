@@ -7,7 +7,7 @@
 - Furniture (``map.obstacles``) is its polygon extruded to its height, as a visual mesh and a
   static triangle-mesh collision shape, so concave pieces are exact.
 
-The same geometry is kept in 2-D for the fast laser, the base's collisions and view culling:
+The same geometry is kept in 2-D for the fast laser and the base's collisions:
 :class:`StaticScene` holds every body's outline as counter-clockwise segments.
 """
 
@@ -31,11 +31,9 @@ FLOOR_TINTS = ((0.78, 0.70, 0.58), (0.70, 0.72, 0.74), (0.74, 0.66, 0.62), (0.68
 @dataclass
 class StaticScene:
     """Outlines of walls and furniture as segments ``(m, 4)`` rows ``[x0, y0, x1, y1]``; each
-    body's outline runs counter-clockwise (its inside on the left of every segment).
-    ``owners[i]`` is the PyBullet body id segment ``i`` belongs to."""
+    body's outline runs counter-clockwise (its inside on the left of every segment)."""
 
     segments: np.ndarray
-    owners: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=int))
 
 
 @dataclass
@@ -48,18 +46,6 @@ class World:
     walls: list[int] = field(default_factory=list)
     obstacles: list[int] = field(default_factory=list)
     scene: StaticScene = field(default_factory=lambda: StaticScene(np.empty((0, 4))))
-    colors: dict[int, tuple[float, float, float, float]] = field(default_factory=dict)
-    """The colour each visible static body was given (for hiding and showing it again)."""
-
-    def wall_segments(self) -> tuple[np.ndarray, np.ndarray]:
-        """The segments of the walls alone and their owners."""
-        keep = np.isin(self.scene.owners, self.walls)
-        return self.scene.segments[keep], self.scene.owners[keep]
-
-    def obstacle_segments(self) -> tuple[np.ndarray, np.ndarray]:
-        """The segments of the furniture alone and their owners."""
-        keep = np.isin(self.scene.owners, self.obstacles)
-        return self.scene.segments[keep], self.scene.owners[keep]
 
 
 def ccw_ring(polygon: shapely.Polygon) -> list[tuple[float, float]]:
@@ -137,18 +123,13 @@ def build_world(client: int, mission: Mission) -> World:
         )
         body = p.createMultiBody(0, -1, vis, physicsClientId=client)
         world.floors[region.name] = body
-        world.colors[body] = rgba
     segs: list[list[float]] = []
-    owners: list[int] = []
     height = mission.map.wall_height
     for box in wall_boxes(layout, mission.map.wall_thickness):
         half = (box.length / 2.0, box.thickness / 2.0, height / 2.0)
         body = _box(client, box.center[0], box.center[1], box.yaw, half)
         world.walls.append(body)
-        world.colors[body] = WALL_RGBA
-        ring_segs = outline(ccw_ring(box.polygon()))
-        segs.extend(ring_segs)
-        owners.extend([body] * len(ring_segs))
+        segs.extend(outline(ccw_ring(box.polygon())))
     for obstacle in layout.obstacles:
         poly = shapely.Polygon(obstacle.polygon)
         vertices, indices, normals = prism_mesh(poly, 0.0, obstacle.height)
@@ -165,13 +146,8 @@ def build_world(client: int, mission: Mission) -> World:
         )
         body = p.createMultiBody(0, col, vis, physicsClientId=client)
         world.obstacles.append(body)
-        world.colors[body] = FURNITURE_RGBA
-        ring_segs = outline(ccw_ring(poly))
-        segs.extend(ring_segs)
-        owners.extend([body] * len(ring_segs))
-    world.scene = StaticScene(
-        np.array(segs, dtype=float).reshape(-1, 4), np.array(owners, dtype=int)
-    )
+        segs.extend(outline(ccw_ring(poly)))
+    world.scene = StaticScene(np.array(segs, dtype=float).reshape(-1, 4))
     return world
 
 
