@@ -477,7 +477,8 @@ class PoseNoise(_Model):
     """Noise of the robot's own pose estimates (simulator)."""
 
     localization_xy: NonNegative = 0.0
-    """Std of the map-frame position the robot reports (white, like AMCL's jitter), metres."""
+    """Std of the error of the map-frame position the robot reports, metres; the error wanders
+    slowly (a Gauss-Markov process with a 2 s correlation time, like AMCL's)."""
     localization_theta: NonNegative = 0.0
     """Std of the map-frame heading the robot reports, radians."""
     odometry_linear: NonNegative = 0.0

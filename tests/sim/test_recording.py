@@ -29,7 +29,10 @@ def _tick(i: int) -> tuple[Observation, GroundTruth]:
     pose = Pose2D(1.0 + 0.1 * i, 2.0, 0.3)
     laser = Pose2D(*map(float, pose.transform([[0.167, 0.0]])[0]), 0.3)
     scan = LaserScan(t, -2.0, 0.01, 0.05, 20.0, np.array([1.0, np.inf, 2.5 + i]), laser)
-    obs = Observation(t, pose, HeadState(0.1, -0.2), scan if i % 2 == 0 else None, None, i)
+    odom = Pose2D(0.1 * i, 0.01 * i, 0.05)  # drifted: the map pose and odometry disagree
+    obs = Observation(
+        t, pose, HeadState(0.1, -0.2), scan if i % 2 == 0 else None, None, i, odometry=odom
+    )
     people = (
         PersonTruth("alice", 3.0, 4.0 + i, 1.0, 0.8, True),
         PersonTruth("bob", 5.0, 4.0, 0.0, 0.5),
@@ -54,6 +57,9 @@ def test_episode_reads_back(tmp_path: Path) -> None:
         assert [p.name for p in got.people] == ["alice", "bob"]
         assert got.people[0].y == pytest.approx(truth.people[0].y)
         assert got.people[0].is_target and not got.people[1].is_target
+    for (_, got_pose), (obs, _) in zip(ep.poses, ticks, strict=True):
+        assert (got_pose.x, got_pose.theta) == pytest.approx((obs.pose.x, obs.pose.theta))
+    assert ep.odometry[3][1].x == pytest.approx(0.3) and ep.odometry[3][1].theta == 0.05
     scan = ep.scans[1]
     assert np.isinf(scan.ranges[1]) and scan.ranges[2] == pytest.approx(4.5)
     assert scan.pose.x == pytest.approx(ticks[2][0].scan.pose.x)

@@ -9,9 +9,11 @@ An episode directory holds
   topic                                         type                            from
   ============================================  ==============================  =================
   ``/hsrb/base_scan``                           sensor_msgs/LaserScan           observation
-  ``/hsrb/odom``                                nav_msgs/Odometry               observation pose
+  ``/global_pose``                              geometry_msgs/PoseStamped       observation pose
+  ``/hsrb/odom``                                nav_msgs/Odometry (``odom``)    odometry
   ``/hsrb/joint_states``                        sensor_msgs/JointState          head pan/tilt
-  ``/tf``                                       tf2_msgs/TFMessage              map→base_footprint
+  ``/tf``                                       tf2_msgs/TFMessage              map→odom
+                                                                                →base_footprint
                                                                                 →base_range_sensor
   ``/hsrb/head_rgbd_sensor/rgb/image_raw``      sensor_msgs/Image (rgb8)        ``images=True``
   ``/hsrb/head_rgbd_sensor/depth/image_raw``    sensor_msgs/Image (32FC1, m)    ``images=True``
@@ -69,12 +71,14 @@ BAG_NAME = "episode.bag"
 TRUTH_NAME = "truth.csv"
 META_NAME = "episode.json"
 MAP_FRAME = "map"
+ODOM_FRAME = "odom"
 BASE_FRAME = "base_footprint"
 LASER_FRAME = "base_range_sensor_link"
 CAMERA_FRAME = "head_rgbd_sensor_rgb_frame"
 
 TOPICS: dict[str, str] = {
     "/hsrb/base_scan": "sensor_msgs/msg/LaserScan",
+    "/global_pose": "geometry_msgs/msg/PoseStamped",
     "/hsrb/odom": "nav_msgs/msg/Odometry",
     "/hsrb/joint_states": "sensor_msgs/msg/JointState",
     "/tf": "tf2_msgs/msg/TFMessage",
@@ -220,17 +224,26 @@ class EpisodeRecorder:
         obs = observation
         zero3 = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
         cov = np.zeros(36, dtype=np.float64)
-        odom = t["nav_msgs/msg/Odometry"](
-            header=self._header(obs.stamp, MAP_FRAME),
-            child_frame_id=BASE_FRAME,
-            pose=t["geometry_msgs/msg/PoseWithCovariance"](
-                pose=self._pose(obs.pose), covariance=cov
-            ),
-            twist=t["geometry_msgs/msg/TwistWithCovariance"](
-                twist=t["geometry_msgs/msg/Twist"](linear=zero3, angular=zero3), covariance=cov
+        self._write(
+            "/global_pose",
+            obs.stamp,
+            t["geometry_msgs/msg/PoseStamped"](
+                header=self._header(obs.stamp, MAP_FRAME), pose=self._pose(obs.pose)
             ),
         )
-        self._write("/hsrb/odom", obs.stamp, odom)
+        if obs.odometry is not None:
+            odom = t["nav_msgs/msg/Odometry"](
+                header=self._header(obs.stamp, ODOM_FRAME),
+                child_frame_id=BASE_FRAME,
+                pose=t["geometry_msgs/msg/PoseWithCovariance"](
+                    pose=self._pose(obs.odometry), covariance=cov
+                ),
+                twist=t["geometry_msgs/msg/TwistWithCovariance"](
+                    twist=t["geometry_msgs/msg/Twist"](linear=zero3, angular=zero3),
+                    covariance=cov,
+                ),
+            )
+            self._write("/hsrb/odom", obs.stamp, odom)
         self._write(
             "/hsrb/joint_states",
             obs.stamp,
@@ -242,7 +255,14 @@ class EpisodeRecorder:
                 effort=np.zeros(0, dtype=np.float64),
             ),
         )
-        transforms = [self._transform(obs.stamp, MAP_FRAME, BASE_FRAME, obs.pose, 0.0)]
+        if obs.odometry is not None:  # map → odom → base, as a localised ROS robot has it
+            map_to_odom = _compose(obs.pose, _inverse(obs.odometry))
+            transforms = [
+                self._transform(obs.stamp, MAP_FRAME, ODOM_FRAME, map_to_odom, 0.0),
+                self._transform(obs.stamp, ODOM_FRAME, BASE_FRAME, obs.odometry, 0.0),
+            ]
+        else:
+            transforms = [self._transform(obs.stamp, MAP_FRAME, BASE_FRAME, obs.pose, 0.0)]
         if obs.scan is not None:
             self._add_scan(obs.scan, obs.pose)
             transforms.append(
@@ -463,6 +483,17 @@ def _wrap(a: float) -> float:
     return math.atan2(math.sin(a), math.cos(a))
 
 
+def _compose(a: Pose2D, b: Pose2D) -> Pose2D:
+    """``b`` (given in ``a``'s frame) in ``a``'s parent frame."""
+    x, y = a.transform([[b.x, b.y]])[0]
+    return Pose2D(float(x), float(y), _wrap(a.theta + b.theta))
+
+
+def _inverse(a: Pose2D) -> Pose2D:
+    """The parent frame's origin seen from ``a``."""
+    return _relative(a, Pose2D(0.0, 0.0, 0.0))
+
+
 # --------------------------------------------------------------------------------------------
 # reading
 
@@ -473,7 +504,10 @@ class Episode:
 
     mission_name: str
     truths: list[GroundTruth] = field(default_factory=list)
+    poses: list[tuple[float, Pose2D]] = field(default_factory=list)
+    """The map-frame poses the robot reported (``/global_pose``)."""
     odometry: list[tuple[float, Pose2D]] = field(default_factory=list)
+    """The odom-frame poses of the wheel odometry (``/hsrb/odom``)."""
     heads: list[tuple[float, HeadState]] = field(default_factory=list)
     scans: list[LaserScan] = field(default_factory=list)
     images: int = 0
@@ -539,6 +573,7 @@ def read_episode(directory: Path) -> Episode:
     store = _typestore()
     by_time: dict[str, dict[int, Any]] = {}
     odom: list[tuple[float, Pose2D]] = []
+    poses: list[tuple[float, Pose2D]] = []
     heads: list[tuple[float, HeadState]] = []
     laser_at: dict[float, Pose2D] = {}
     scans: list[Any] = []
@@ -550,6 +585,8 @@ def read_episode(directory: Path) -> Episode:
                 topic = conn.topic
                 if topic == "/hsrb/odom":
                     odom.append((_stamp(msg.header), _pose2d(msg.pose.pose)))
+                elif topic == "/global_pose":
+                    poses.append((_stamp(msg.header), _pose2d(msg.pose)))
                 elif topic == "/hsrb/joint_states":
                     pos = dict(zip(msg.name, msg.position, strict=True))
                     heads.append(
@@ -565,6 +602,8 @@ def read_episode(directory: Path) -> Episode:
                     frames = {tr.child_frame_id: tr for tr in msg.transforms}
                     if LASER_FRAME in frames and BASE_FRAME in frames:
                         base = _tf_pose(frames[BASE_FRAME])
+                        if ODOM_FRAME in frames:  # map → odom → base
+                            base = _compose(_tf_pose(frames[ODOM_FRAME]), base)
                         rel = _tf_pose(frames[LASER_FRAME])
                         laser_at[round(_stamp(frames[LASER_FRAME].header), 9)] = Pose2D(
                             *map(float, base.transform([[rel.x, rel.y]])[0]),
@@ -578,7 +617,9 @@ def read_episode(directory: Path) -> Episode:
                     by_time.setdefault(topic, {})[ts] = msg
     except Exception as err:  # rosbags raises its own errors for a damaged bag
         raise RecordingError(f"{bag}: cannot read the bag: {err}") from None
-    episode = Episode(mission_name=mission_name, odometry=odom, heads=heads, images=images)
+    episode = Episode(
+        mission_name=mission_name, poses=poses, odometry=odom, heads=heads, images=images
+    )
     for msg in scans:
         s = _stamp(msg.header)
         episode.scans.append(

@@ -18,9 +18,11 @@ no longer than the laser's period. In each sub-step
    the people and the robot are placed before anything is rendered or ray cast.
 
 :meth:`SimRobot.observe` hands out the newest scan and frame (each once), the head angles, the
-collision count, the map-frame pose as localisation reports it (true pose plus
-``sensors.pose.localization_*`` noise) and the odometry (integrated from the motion with
-``sensors.pose.odometry_*`` noise, so it drifts; its frame starts at the start pose).
+collision count, the map-frame pose as localisation reports it (the true pose plus an error that
+wanders slowly, std ``sensors.pose.localization_*``; each scan's pose is the laser's pose as the
+robot believes it, so the scan lands in the map as it would on the real robot) and the odometry
+(integrated from the motion with ``sensors.pose.odometry_*`` noise, so it drifts; its frame
+starts at the start pose).
 :meth:`SimRobot.ground_truth` is kept apart for metrics and recording. MOVE_BASE itself plans
 with the true pose. Everything random is drawn from the seed, so the same mission and seed give
 the same episode; ``gui`` opens PyBullet's window and ``realtime`` paces the steps to the clock.
@@ -30,7 +32,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -63,6 +65,8 @@ from pfctl.mission import Mission
 PERSON_CONTACT_RADIUS = 0.2
 #: Extra room a walking person leaves the robot, metres.
 PERSON_COURTESY = 0.15
+#: Correlation time of the localisation error, seconds.
+LOCALIZATION_TAU = 2.0
 #: Shortest sub-step rate when the laser is slow, Hz.
 MIN_SUBSTEP_HZ = 20.0
 
@@ -118,6 +122,7 @@ class SimRobot:
         rngs = [np.random.default_rng([self.seed, k]) for k in range(4)]
         laser_seed, camera_seed = (int(r.integers(2**31)) for r in rngs[:2])
         self._pose_rng, self._odom_rng = rngs[2], rngs[3]
+        self._loc_error = np.zeros(3)  # localisation error (x, y, theta), map frame
         self._client = p.connect(p.GUI if self.options.gui else p.DIRECT)
         self._closed = False
         try:
@@ -219,6 +224,7 @@ class SimRobot:
                 if self.navigator.status is not NavStatus.ACTIVE:
                     self._navigating = False
             self._move(dt)
+            self._localization_step(dt)
             self.head.update(dt)
             clear = self.mission.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
             for walker in self.people:
@@ -236,7 +242,7 @@ class SimRobot:
         self._scan = self._frame = None
         return Observation(
             stamp=self.time,
-            pose=self._localized(),
+            pose=self.localized_pose,
             head=self.head.state,
             scan=scan,
             rgbd=frame,
@@ -301,15 +307,28 @@ class SimRobot:
         if dx or dy or dth:
             self.odometry = compose(self.odometry, dx, dy, dth)
 
-    def _localized(self) -> Pose2D:
+    def _localization_step(self, dt: float) -> None:
+        """The localisation error as a first-order Gauss-Markov process (correlation time
+        :data:`LOCALIZATION_TAU`) whose steady-state std is ``sensors.pose.localization_*``."""
         noise = self.mission.sensors.pose
         if noise.localization_xy == 0 and noise.localization_theta == 0:
+            return
+        a = math.exp(-dt / LOCALIZATION_TAU)
+        sigma = np.array([noise.localization_xy, noise.localization_xy, noise.localization_theta])
+        self._loc_error = a * self._loc_error + math.sqrt(1.0 - a * a) * sigma * (
+            self._pose_rng.normal(size=3)
+        )
+
+    @property
+    def localized_pose(self) -> Pose2D:
+        """The map-frame pose as the robot's localisation reports it (true pose + its error)."""
+        e = self._loc_error
+        if not e.any():
             return self.pose
-        e = self._pose_rng.normal(size=3)
-        theta = self.pose.theta + noise.localization_theta * float(e[2])
+        theta = self.pose.theta + float(e[2])
         return Pose2D(
-            self.pose.x + noise.localization_xy * float(e[0]),
-            self.pose.y + noise.localization_xy * float(e[1]),
+            self.pose.x + float(e[0]),
+            self.pose.y + float(e[1]),
             math.atan2(math.sin(theta), math.cos(theta)),
         )
 
@@ -330,8 +349,10 @@ class SimRobot:
             if isinstance(self.laser, BulletLaser):
                 self._sync_bodies()
                 synced = True
-            self._scan = self.laser.scan(self.pose, self._legs(), self.time)
-            self._scan_points = self._scan.points()
+            scan = self.laser.scan(self.pose, self._legs(), self.time)
+            self._scan_points = scan.points()  # MOVE_BASE's view, with the true pose
+            believed = self.laser_spec.laser_pose(self.localized_pose)
+            self._scan = scan if believed == scan.pose else replace(scan, pose=believed)
             period = 1.0 / self.mission.sensors.laser.rate_hz
             while self._next_scan <= self.time + eps:
                 self._next_scan += period
