@@ -1,5 +1,9 @@
 """`pfctl sim`: the simulated house.
 
+- ``run MISSION``: run the house with the scenario's people for a while, the robot standing
+  still, replaying a velocity script (``--script``) or driven from the keyboard (``--teleop``);
+  optionally record the episode (``--record DIR``, a ROS 1 bag and sidecars); draw everyone's
+  paths on a top-down PNG and print what happened.
 - ``export-map MISSION --out map.yaml``: the static occupancy grid the simulator's walls and
   furniture imply (:func:`pfctl.core.walls.rasterize_house`), as a ROS map_server map.
 
@@ -9,19 +13,217 @@ atomically.
 
 from __future__ import annotations
 
+import itertools
 import math
+import os
+import sys
+from collections.abc import Callable
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from pfctl.core.grid import GridFileError
+from pfctl.core.planning import NoPathError
 from pfctl.core.walls import rasterize_house
 from pfctl.errors import UserError
-from pfctl.mission import load_mission
+from pfctl.mission import Mission, load_mission
 
-app = typer.Typer(help="The simulated house: export its map.", no_args_is_help=True)
+if TYPE_CHECKING:  # the simulator is imported when a command needs it: pybullet loads slowly
+    from pfctl.backends.pybullet.runner import RunResult
+
+app = typer.Typer(help="The simulated house: run it, export its map.", no_args_is_help=True)
+
+
+@app.command("run")
+def run(
+    mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
+    duration: Annotated[float, typer.Option("--duration", help="Simulated seconds to run.")] = 60.0,
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+    ] = None,
+    record: Annotated[
+        Path | None,
+        typer.Option("--record", help="Write the episode here: a ROS 1 bag and sidecars."),
+    ] = None,
+    record_images: Annotated[
+        bool, typer.Option("--record-images", help="Also record the RGB-D images (large).")
+    ] = False,
+    png: Annotated[
+        Path | None,
+        typer.Option(
+            "--png", help="Top-down picture of the paths [default: DIR/paths.png or sim_run.png]."
+        ),
+    ] = None,
+    script: Annotated[
+        Path | None,
+        typer.Option("--script", help="Drive by a velocity script: CSV t,vx,vy,wz[,pan,tilt]."),
+    ] = None,
+    teleop: Annotated[
+        bool, typer.Option("--teleop", help="Drive from the keyboard (paces to the clock).")
+    ] = False,
+    gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window to watch.")] = False,
+    realtime: Annotated[
+        bool, typer.Option("--realtime", help="Pace the simulation to the wall clock.")
+    ] = False,
+    camera: Annotated[
+        bool, typer.Option("--camera/--no-camera", help="Render the head's RGB-D camera.")
+    ] = True,
+    laser: Annotated[
+        str, typer.Option("--laser", help="Laser model: fast (2-D, default) or bullet.")
+    ] = "fast",
+) -> None:
+    """Run the simulated house: people walk their routes; the robot stands, replays a script or
+    is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
+    from pfctl.backends.pybullet import drivers
+    from pfctl.backends.pybullet.episode_plot import plot_episode
+    from pfctl.backends.pybullet.recording import Episode, EpisodeRecorder, RecordingError
+    from pfctl.backends.pybullet.runner import graceful_interrupts, run_episode
+    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+
+    if not (math.isfinite(duration) and duration > 0):
+        raise UserError(f"--duration: expected a positive number of seconds, got {duration}")
+    if laser not in ("fast", "bullet"):
+        raise UserError(f"--laser: expected fast or bullet, got {laser!r}")
+    if script is not None and teleop:
+        raise UserError("--script and --teleop: expected one way to drive the robot, got both")
+    if gui and sys.platform.startswith("linux") and not os.environ.get("DISPLAY"):
+        raise UserError("--gui: no display (DISPLAY is not set); run without --gui for headless")
+    if teleop and not gui and not sys.stdin.isatty():
+        raise UserError("--teleop: stdin is not a terminal; run it in a terminal or with --gui")
+    if record is not None:
+        _check_episode_dir(record)
+    if png is None:
+        png = record / "paths.png" if record is not None else Path("sim_run.png")
+    if png.suffix.lower() != ".png":
+        raise UserError(f"--png {png}: expected a path ending in .png")
+    if png.is_dir():
+        raise UserError(f"--png {png}: is a directory, expected a file path")
+    loaded = load_mission(mission)
+    steps = None
+    if script is not None:
+        try:
+            steps = drivers.read_velocity_script(script)
+        except drivers.ScriptError as err:
+            raise UserError(str(err)) from None
+    options = SimOptions(
+        seed=seed,
+        gui=gui,
+        realtime=realtime or teleop,
+        camera=camera,
+        laser_model="bullet" if laser == "bullet" else "fast",
+    )
+    try:
+        robot = SimRobot(loaded, options)
+    except NoPathError as err:
+        raise UserError(f"{mission}: scenario.people: a route cannot be walked: {err}") from None
+    console = Console(stderr=True)
+    with robot:
+        driver: drivers.ScriptedDriver | drivers.KeyboardDriver | None = None
+        if steps is not None:
+            driver = drivers.ScriptedDriver(steps)
+        elif teleop:
+            driver = drivers.KeyboardDriver(
+                loaded.robot.max_linear_speed, loaded.robot.max_angular_speed
+            )
+            console.print(drivers.HELP)
+        try:
+            recorder = (
+                EpisodeRecorder(record, loaded.name, images=record_images and camera)
+                if record is not None
+                else None
+            )
+        except RecordingError as err:
+            raise UserError(str(err)) from None
+        try:
+            with graceful_interrupts() as stop, _Progress(console, duration) as tick:
+                if teleop and not gui:
+                    with drivers.TerminalKeys() as terminal:
+                        result = run_episode(
+                            robot, duration, driver, recorder, terminal.read, tick, stop
+                        )
+                else:
+                    keys = (lambda: drivers.window_keys(robot.client)) if teleop else None
+                    result = run_episode(robot, duration, driver, recorder, keys, tick, stop)
+            if recorder is not None:
+                recorder.close()
+        except BaseException:
+            if recorder is not None:
+                recorder.abort()
+            raise
+        episode = Episode(mission_name=loaded.name, truths=result.truths)
+        try:
+            png.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as err:
+            raise UserError(f"--png {png}: cannot create its folder: {err.strerror}") from None
+        title = f"{loaded.name}: {result.sim_time:.1f} s simulated, seed {robot.seed}"
+        picture = plot_episode(robot.static_map, loaded.layout(), episode, png, title=title)
+    _report(loaded, result, robot.collisions, picture, record)
+    if result.interrupted:
+        raise typer.Exit(130)
+
+
+def _check_episode_dir(path: Path) -> None:
+    """Refuse to write an episode over a file or over a folder that holds something else."""
+    if path.exists() and not path.is_dir():
+        raise UserError(f"--record {path}: exists and is not a directory")
+    if path.is_dir() and any(path.iterdir()) and not (path / "episode.json").is_file():
+        raise UserError(
+            f"--record {path}: a folder that is neither empty nor an episode; choose another"
+        )
+
+
+class _Progress:
+    """A progress bar of simulated time on stderr (hidden when stderr is not a terminal)."""
+
+    def __init__(self, console: Console, duration: float) -> None:
+        self.duration = duration
+        self.bar = Progress(
+            TextColumn("simulating"),
+            BarColumn(),
+            TextColumn("{task.completed:.1f}/{task.total:.0f} s"),
+            TimeRemainingColumn(),
+            console=console,
+            transient=True,
+            disable=not console.is_terminal,
+        )
+
+    def __enter__(self) -> Callable[[float], None]:
+        self.bar.__enter__()
+        task = self.bar.add_task("sim", total=self.duration)
+        return lambda t: self.bar.update(task, completed=min(t, self.duration))
+
+    def __exit__(self, *exc: object) -> None:
+        self.bar.__exit__(None, None, None)
+
+
+def _report(
+    mission: Mission, result: RunResult, collisions: int, picture: Path, record: Path | None
+) -> None:
+    out = Console(width=100, soft_wrap=True)
+    status = "interrupted after" if result.interrupted else "ran"
+    out.print(
+        f"{status} {result.sim_time:.1f} s simulated in {result.wall_time:.1f} s "
+        f"({result.real_time_factor:.1f}x real time): {result.scans} scans, "
+        f"{result.frames} camera frames, {collisions} collisions"
+    )
+    truths = result.truths
+    if len(truths) > 1:
+        robot = [(g.robot.x, g.robot.y) for g in truths]
+        out.print(f"  robot: {_length(robot):.2f} m driven")
+        for k, person in enumerate(truths[0].people):
+            path = [(g.people[k].x, g.people[k].y) for g in truths]
+            role = "target" if person.is_target else "distractor"
+            out.print(f"  {person.name} ({role}): {_length(path):.2f} m walked")
+    if record is not None:
+        out.print(f"wrote the episode to {record}/ (episode.bag, truth.csv, episode.json)")
+    out.print(f"wrote {picture}")
+
+
+def _length(points: list[tuple[float, float]]) -> float:
+    return sum(math.dist(a, b) for a, b in itertools.pairwise(points))
 
 
 @app.command("export-map")

@@ -165,6 +165,11 @@ class SimRobot:
         self._wall_start: float | None = None
         self._sense()  # the first scan and frame exist before the first step
 
+    @property
+    def client(self) -> int:
+        """The PyBullet client of this simulation."""
+        return self._client
+
     # -- context manager ----------------------------------------------------------------------
 
     def __enter__(self) -> SimRobot:
