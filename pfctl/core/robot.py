@@ -38,6 +38,29 @@ class Pose2D:
         """Euclidean distance between the two positions (m)."""
         return math.hypot(other.x - self.x, other.y - self.y)
 
+    def compose(self, other: Pose2D) -> Pose2D:
+        """``other``, given in this pose's frame, in the parent frame (``self ⊕ other``)."""
+        c, s = math.cos(self.theta), math.sin(self.theta)
+        return Pose2D(
+            self.x + c * other.x - s * other.y,
+            self.y + s * other.x + c * other.y,
+            wrap_angle(self.theta + other.theta),
+        )
+
+    def inverse(self) -> Pose2D:
+        """The parent frame's origin seen from this pose (``self ⊕ self.inverse()`` = 0)."""
+        c, s = math.cos(self.theta), math.sin(self.theta)
+        return Pose2D(-c * self.x - s * self.y, s * self.x - c * self.y, wrap_angle(-self.theta))
+
+    def relative(self, other: Pose2D) -> Pose2D:
+        """``other`` (a pose in the parent frame) seen from this pose (``self⁻¹ ⊕ other``)."""
+        return self.inverse().compose(other)
+
+
+def wrap_angle(angle: float) -> float:
+    """The angle in (−π, π]."""
+    return math.atan2(math.sin(angle), math.cos(angle))
+
 
 @dataclass(frozen=True)
 class Twist2D:

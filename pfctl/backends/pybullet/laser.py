@@ -61,8 +61,7 @@ class LaserSpec:
 
     def laser_pose(self, pose: Pose2D) -> Pose2D:
         """The laser's map-frame pose for a base pose (mounted ``mount_x`` ahead of the centre)."""
-        c, s = math.cos(pose.theta), math.sin(pose.theta)
-        return Pose2D(pose.x + self.mount_x * c, pose.y + self.mount_x * s, pose.theta)
+        return pose.compose(Pose2D(self.mount_x, 0.0, 0.0))
 
     def directions(self, laser: Pose2D) -> np.ndarray:
         """Unit map-frame directions ``(beams, 2)`` of the beams from ``laser``."""

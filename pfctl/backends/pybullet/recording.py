@@ -256,7 +256,7 @@ class EpisodeRecorder:
             ),
         )
         if obs.odometry is not None:  # map → odom → base, as a localised ROS robot has it
-            map_to_odom = _compose(obs.pose, _inverse(obs.odometry))
+            map_to_odom = obs.pose.compose(obs.odometry.inverse())
             transforms = [
                 self._transform(obs.stamp, MAP_FRAME, ODOM_FRAME, map_to_odom, 0.0),
                 self._transform(obs.stamp, ODOM_FRAME, BASE_FRAME, obs.odometry, 0.0),
@@ -267,7 +267,7 @@ class EpisodeRecorder:
             self._add_scan(obs.scan, obs.pose)
             transforms.append(
                 self._transform(
-                    obs.scan.stamp, BASE_FRAME, LASER_FRAME, _relative(obs.pose, obs.scan.pose), 0.0
+                    obs.scan.stamp, BASE_FRAME, LASER_FRAME, obs.pose.relative(obs.scan.pose), 0.0
                 )
             )
         self._write("/tf", obs.stamp, t["tf2_msgs/msg/TFMessage"](transforms=transforms))
@@ -472,28 +472,6 @@ class EpisodeRecorder:
             self.abort()
 
 
-def _relative(base: Pose2D, pose: Pose2D) -> Pose2D:
-    """``pose`` expressed in ``base``'s frame."""
-    c, s = math.cos(base.theta), math.sin(base.theta)
-    dx, dy = pose.x - base.x, pose.y - base.y
-    return Pose2D(c * dx + s * dy, -s * dx + c * dy, _wrap(pose.theta - base.theta))
-
-
-def _wrap(a: float) -> float:
-    return math.atan2(math.sin(a), math.cos(a))
-
-
-def _compose(a: Pose2D, b: Pose2D) -> Pose2D:
-    """``b`` (given in ``a``'s frame) in ``a``'s parent frame."""
-    x, y = a.transform([[b.x, b.y]])[0]
-    return Pose2D(float(x), float(y), _wrap(a.theta + b.theta))
-
-
-def _inverse(a: Pose2D) -> Pose2D:
-    """The parent frame's origin seen from ``a``."""
-    return _relative(a, Pose2D(0.0, 0.0, 0.0))
-
-
 # --------------------------------------------------------------------------------------------
 # reading
 
@@ -603,12 +581,9 @@ def read_episode(directory: Path) -> Episode:
                     if LASER_FRAME in frames and BASE_FRAME in frames:
                         base = _tf_pose(frames[BASE_FRAME])
                         if ODOM_FRAME in frames:  # map → odom → base
-                            base = _compose(_tf_pose(frames[ODOM_FRAME]), base)
+                            base = _tf_pose(frames[ODOM_FRAME]).compose(base)
                         rel = _tf_pose(frames[LASER_FRAME])
-                        laser_at[round(_stamp(frames[LASER_FRAME].header), 9)] = Pose2D(
-                            *map(float, base.transform([[rel.x, rel.y]])[0]),
-                            _wrap(base.theta + rel.theta),
-                        )
+                        laser_at[round(_stamp(frames[LASER_FRAME].header), 9)] = base.compose(rel)
                 elif topic == "/hsrb/base_scan":
                     scans.append(msg)
                 elif topic == IMAGE_TOPICS[0]:
