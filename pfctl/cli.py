@@ -9,6 +9,7 @@ import typer
 from pfctl import __version__
 from pfctl.commands import map as map_commands
 from pfctl.commands import mission as mission_commands
+from pfctl.commands import predict as predict_commands
 from pfctl.commands import sim as sim_commands
 from pfctl.errors import UserError
 
@@ -24,6 +25,7 @@ app = typer.Typer(
 app.add_typer(mission_commands.app, name="mission")
 app.add_typer(map_commands.app, name="map")
 app.add_typer(sim_commands.app, name="sim")
+app.add_typer(predict_commands.app, name="predict")
 
 
 def _version(value: bool) -> None:
