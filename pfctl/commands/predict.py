@@ -503,7 +503,7 @@ DEFAULT_GRIDS: dict[str, dict[str, list[Any]]] = {
     },
     "svr-time": {
         "C": [100.0, 1000.0],
-        "gamma": [0.3, 1.0, 3.0],
+        "gamma": [0.01, 0.03, 0.1, 0.3, 1.0],
         "epsilon": [0.01],
         "half_life_s": [0.5, 1.0, 2.0],
     },
