@@ -13,8 +13,8 @@ import sys
 from pathlib import Path
 
 import pytest
+from conftest import run_cli
 
-from pfctl import cli
 from pfctl.core.house import HouseLayout
 from pfctl.errors import MissionError
 from pfctl.mission import (
@@ -59,18 +59,6 @@ map:
   regions:
     - {name: room, polygon: [[0, 0], [3, 0], [3, 2], [0, 2]]}
 """
-
-
-def run_cli(
-    args: list[str], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-) -> tuple[int, str, str]:
-    """Run ``pfctl ARGS`` in-process exactly as the console script does; (status, out, err)."""
-    monkeypatch.setattr(sys, "argv", ["pfctl", *args])
-    with pytest.raises(SystemExit) as exited:
-        cli.main()
-    captured = capsys.readouterr()
-    code = exited.value.code
-    return (code if isinstance(code, int) else 0 if code is None else 1), captured.out, captured.err
 
 
 def run_subprocess(args: list[str], cwd: Path) -> subprocess.CompletedProcess[str]:

@@ -11,25 +11,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
-from pfctl import cli
+from conftest import run_cli
 
 ROOT = Path(__file__).resolve().parents[1]
 HOUSE = ROOT / "missions" / "house.yaml"
 PEDESTRIANS = (ROOT / ".." / "shared" / "data" / "pedestrians").resolve()
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
-
-
-def run_cli(
-    args: list[str], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-) -> tuple[int, str, str]:
-    """Run ``pfctl ARGS`` in-process as the console script does; (status, stdout, stderr)."""
-    monkeypatch.setattr(sys, "argv", ["pfctl", *args])
-    with pytest.raises(SystemExit) as exited:
-        cli.main()
-    captured = capsys.readouterr()
-    code = exited.value.code
-    return (code if isinstance(code, int) else 0 if code is None else 1), captured.out, captured.err
 
 
 def assert_one_error_line(err: str, *fragments: str) -> None:

@@ -12,10 +12,10 @@ import time
 from pathlib import Path
 
 import pytest
+from conftest import run_cli
 
 from pfctl.backends.pybullet.drivers import ScriptError, read_velocity_script
 from pfctl.backends.pybullet.recording import read_episode
-from pfctl.cli import main
 
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -57,16 +57,6 @@ def test_the_picture_goes_where_asked_and_the_camera_runs(tmp_path: Path) -> Non
     assert out.read_bytes()[:8] == PNG
 
 
-def _pfctl_here(
-    args: tuple[str, ...], capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
-) -> tuple[int, str]:
-    """Run the CLI in this process (fast): its exit status and stderr."""
-    monkeypatch.setattr(sys, "argv", ["pfctl", *args])
-    with pytest.raises(SystemExit) as exited:
-        main()
-    return int(exited.value.code or 0), capsys.readouterr().err
-
-
 def test_bad_input_is_one_line_and_exit_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -90,7 +80,7 @@ def test_bad_input_is_one_line_and_exit_2(
         (("sim", "run", str(tmp_path / "nope.yaml")), "nope.yaml"),
     ]
     for args, message in cases:
-        code, err = _pfctl_here(args, capsys, monkeypatch)
+        code, _, err = run_cli(list(args), capsys, monkeypatch)
         assert code == 2, (args, err)
         assert err.startswith("pfctl: error: ") and err.count("\n") == 1
         assert message in err
