@@ -30,8 +30,7 @@ from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
-import pybullet  # noqa: E402
-
+from pfctl.backends.pybullet import simulation  # noqa: E402
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
 from pfctl.core.regions import RegionMap  # noqa: E402
 from pfctl.core.robot import NavStatus, Pose2D  # noqa: E402
@@ -93,7 +92,8 @@ def main() -> None:
     cam = mission.sensors.camera
     print(
         f"{platform.platform()} | {platform.processor() or platform.machine()} | "
-        f"Python {platform.python_version()} | pybullet API {pybullet.getAPIVersion()} | one core"
+        f"Python {platform.python_version()} | "
+        f"pybullet API {simulation.p.getAPIVersion()} | one core"
     )
     print(
         f"missions/house.yaml, 4 people, {args.duration:g} s simulated per run, "
