@@ -102,6 +102,33 @@ def _box(client: int, cx: float, cy: float, yaw: float, half: tuple[float, float
     return p.createMultiBody(0, col, vis, [cx, cy, half[2]], orn, physicsClientId=client)
 
 
+def _mesh_body(
+    client: int,
+    mesh: tuple[list[list[float]], list[int], list[list[float]]],
+    rgba: tuple[float, float, float, float],
+    solid: bool,
+) -> int:
+    """A static body drawn as ``mesh``; with ``solid`` also a triangle-mesh collision shape (exact
+    for concave shapes, as static bodies may have)."""
+    vertices, indices, normals = mesh
+    col = (
+        p.createCollisionShape(
+            p.GEOM_MESH, vertices=vertices, indices=indices, physicsClientId=client
+        )
+        if solid
+        else -1
+    )
+    vis = p.createVisualShape(
+        p.GEOM_MESH,
+        vertices=vertices,
+        indices=indices,
+        normals=normals,
+        rgbaColor=rgba,
+        physicsClientId=client,
+    )
+    return p.createMultiBody(0, col, vis, physicsClientId=client)
+
+
 def build_world(client: int, mission: Mission) -> World:
     """Ground, floors, walls (``wall_boxes`` extruded to ``wall_height``) and furniture."""
     ground_col = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=client)
@@ -111,18 +138,9 @@ def build_world(client: int, mission: Mission) -> World:
     world = World(ground=p.createMultiBody(0, ground_col, ground_vis, physicsClientId=client))
     layout = mission.layout()
     for k, region in enumerate(layout.regions):
-        vertices, indices, normals = prism_mesh(shapely.Polygon(region.polygon), 0, 0, sides=False)
         rgba = (*FLOOR_TINTS[k % len(FLOOR_TINTS)], 1.0)
-        vis = p.createVisualShape(
-            p.GEOM_MESH,
-            vertices=vertices,
-            indices=indices,
-            normals=normals,
-            rgbaColor=rgba,
-            physicsClientId=client,
-        )
-        body = p.createMultiBody(0, -1, vis, physicsClientId=client)
-        world.floors[region.name] = body
+        top = prism_mesh(shapely.Polygon(region.polygon), 0.0, 0.0, sides=False)
+        world.floors[region.name] = _mesh_body(client, top, rgba, solid=False)
     segs: list[list[float]] = []
     height = mission.map.wall_height
     for box in wall_boxes(layout, mission.map.wall_thickness):
@@ -132,20 +150,8 @@ def build_world(client: int, mission: Mission) -> World:
         segs.extend(outline(ccw_ring(box.polygon())))
     for obstacle in layout.obstacles:
         poly = shapely.Polygon(obstacle.polygon)
-        vertices, indices, normals = prism_mesh(poly, 0.0, obstacle.height)
-        col = p.createCollisionShape(
-            p.GEOM_MESH, vertices=vertices, indices=indices, physicsClientId=client
-        )
-        vis = p.createVisualShape(
-            p.GEOM_MESH,
-            vertices=vertices,
-            indices=indices,
-            normals=normals,
-            rgbaColor=FURNITURE_RGBA,
-            physicsClientId=client,
-        )
-        body = p.createMultiBody(0, col, vis, physicsClientId=client)
-        world.obstacles.append(body)
+        mesh = prism_mesh(poly, 0.0, obstacle.height)
+        world.obstacles.append(_mesh_body(client, mesh, FURNITURE_RGBA, solid=True))
         segs.extend(outline(ccw_ring(poly)))
     world.scene = StaticScene(np.array(segs, dtype=float).reshape(-1, 4))
     return world
