@@ -223,6 +223,16 @@ class SensorModel(_Model):
         return self
 
 
+def _existing_file(value: Path, info: ValidationInfo, what: str) -> Path:
+    """``value`` resolved against the mission file's folder; an error when it is no file."""
+    context = info.context if isinstance(info.context, Mapping) else {}
+    base = Path(context.get("base_dir", "."))
+    path = value if value.is_absolute() else base / value
+    if not path.is_file():
+        raise _error("file_missing", f"expected {what}, but {path} does not exist")
+    return path.resolve()
+
+
 class RegionSpec(_Model):
     """A named polygon of the region map (§II-B)."""
 
@@ -272,15 +282,7 @@ class MapConfig(_Model):
         """Resolve the map_server YAML relative to the mission file and check that it exists."""
         if value is None:
             return None
-        context = info.context if isinstance(info.context, Mapping) else {}
-        base = Path(context.get("base_dir", "."))
-        path = value if value.is_absolute() else base / value
-        if not path.is_file():
-            raise _error(
-                "file_missing",
-                f"expected an existing map_server YAML file, but {path} does not exist",
-            )
-        return path.resolve()
+        return _existing_file(value, info, "an existing map_server YAML file")
 
     @model_validator(mode="after")
     def _geometry(self) -> MapConfig:
@@ -495,15 +497,61 @@ class SensorsConfig(_Model):
     pose: PoseNoise = PoseNoise()
 
 
-class PerceptionConfig(_Model):
-    """Thresholds of leg detection and target identification (§II-E, Algorithm 2)."""
+class LegsConfig(_Model):
+    """Leg detection from the 2-D laser (§II-E; segment features of Arras et al. 2007)."""
 
-    leg_probability: Probability = 0.5
+    model: Path | None = None
+    """A model written by ``pfctl legs train`` (relative to the mission file); default: the
+    model shipped with pfctl."""
+    probability: Probability = 0.5
     """Random-forest score above which a laser segment is a leg."""
+    jump_distance: Positive = 0.13
+    """A segment ends where two neighbouring returns are farther apart than this, metres."""
+    min_points: Annotated[int, Field(ge=2), _NO_BOOL] = 3
+    """Segments with fewer returns are not classified."""
+    max_range: Positive = 6.0
+    """Segments farther from the laser than this are not classified, metres."""
+    pair_distance: Positive = 0.6
+    """Two legs closer than this form one person candidate, metres."""
+
+    @field_validator("model")
+    @classmethod
+    def _model_exists(cls, value: Path | None, info: ValidationInfo) -> Path | None:
+        """Resolve the model file relative to the mission file and check that it exists."""
+        if value is None:
+            return None
+        return _existing_file(value, info, "a leg model file (pfctl legs train)")
+
+
+class VisionConfig(_Model):
+    """Person detection on the RGB-D camera (§II-E)."""
+
+    detector: Literal["auto", "mask", "hog"] = "auto"
+    """``mask``: the simulator's segmentation (stands in for OpenPose); ``hog``: OpenCV's HOG
+    people detector for real cameras; ``auto``: ``mask`` when the frame has one, else ``hog``."""
+    min_pixels: Count = 150
+    """Fewer body pixels than this is no detection."""
+
+
+class IdentityConfig(_Model):
+    """Target identification (Algorithm 2): faces, then clothes histograms."""
+
     face_distance: Positive = 0.6
     """Face-embedding distance below which two faces match."""
     clothes_similarity: UnitInterval = 0.6
-    """Histogram intersection S above which clothes match (Algorithm 2)."""
+    """Histogram intersection S above which clothes match."""
+    color_space: Literal["hsv", "rgb", "lab"] = "hsv"
+    """Colour space of the clothing histograms."""
+    bins: tuple[Count, Count, Count] = (16, 4, 4)
+    """Histogram bins per channel of ``color_space``."""
+
+
+class PerceptionConfig(_Model):
+    """Leg detection, person detection and target identification (§II-E, Algorithm 2)."""
+
+    legs: LegsConfig = LegsConfig()
+    vision: VisionConfig = VisionConfig()
+    identity: IdentityConfig = IdentityConfig()
 
 
 class TrackingConfig(_Model):
@@ -517,6 +565,14 @@ class TrackingConfig(_Model):
     """Std of a camera position, m."""
     gate: Positive = 9.21
     """Squared Mahalanobis gate (chi², 2 dof, 99 %)."""
+    confirm_hits: Count = 3
+    """A tentative track is confirmed after this many associated detections."""
+    tentative_timeout_s: Positive = 0.5
+    """A tentative track unseen for this long is deleted."""
+    max_coast_s: Positive = 1.5
+    """A confirmed track unseen for this long while inside a sensor's field of view is deleted."""
+    max_coast_unseen_s: Positive = 5.0
+    """A confirmed track outside every sensor's field of view coasts this long before deletion."""
 
 
 class BeliefConfig(_Model):
