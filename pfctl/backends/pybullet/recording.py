@@ -15,6 +15,9 @@ An episode directory holds
   ``/tf``                                       tf2_msgs/TFMessage              map→odom
                                                                                 →base_footprint
                                                                                 →base_range_sensor
+                                                                                (→head_rgbd_sensor
+                                                                                _rgb_frame, 3-D,
+                                                                                with images)
   ``/hsrb/head_rgbd_sensor/rgb/image_raw``      sensor_msgs/Image (rgb8)        ``images=True``
   ``/hsrb/head_rgbd_sensor/depth/image_raw``    sensor_msgs/Image (32FC1, m)    ``images=True``
   ``/hsrb/head_rgbd_sensor/rgb/camera_info``    sensor_msgs/CameraInfo          ``images=True``
@@ -55,6 +58,7 @@ from typing import Any
 import numpy as np
 from rosbags.rosbag1 import Reader, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+from scipy.spatial.transform import Rotation
 
 from pfctl.core.robot import (
     GroundTruth,
@@ -204,6 +208,32 @@ class EpisodeRecorder:
             ),
         )
 
+    def _camera_transform(self, frame: RgbdFrame, base: Pose2D) -> Any:
+        """``base_footprint → head_rgbd_sensor_rgb_frame`` (3-D: the optical frame, z forward)."""
+        t = self._types()
+        map_base = np.eye(4)
+        map_base[:2, :2] = [
+            [math.cos(base.theta), -math.sin(base.theta)],
+            [math.sin(base.theta), math.cos(base.theta)],
+        ]
+        map_base[:2, 3] = (base.x, base.y)
+        map_camera = np.eye(4)
+        map_camera[:3, :3] = frame.camera_rotation
+        map_camera[:3, 3] = frame.camera_position
+        base_camera = np.linalg.solve(map_base, map_camera)
+        qx, qy, qz, qw = Rotation.from_matrix(base_camera[:3, :3]).as_quat()
+        x, y, z = (float(v) for v in base_camera[:3, 3])
+        return t["geometry_msgs/msg/TransformStamped"](
+            header=self._header(frame.stamp, BASE_FRAME),
+            child_frame_id=CAMERA_FRAME,
+            transform=t["geometry_msgs/msg/Transform"](
+                translation=t["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
+                rotation=t["geometry_msgs/msg/Quaternion"](
+                    x=float(qx), y=float(qy), z=float(qz), w=float(qw)
+                ),
+            ),
+        )
+
     def _write(self, topic: str, stamp: float, msg: Any) -> None:
         conn = self._conns[topic]
         data = self._store.serialize_ros1(msg, conn.msgtype)
@@ -270,9 +300,10 @@ class EpisodeRecorder:
                     obs.scan.stamp, BASE_FRAME, LASER_FRAME, obs.pose.relative(obs.scan.pose), 0.0
                 )
             )
-        self._write("/tf", obs.stamp, t["tf2_msgs/msg/TFMessage"](transforms=transforms))
         if obs.rgbd is not None and self.images:
             self._add_rgbd(obs.rgbd)
+            transforms.append(self._camera_transform(obs.rgbd, obs.pose))
+        self._write("/tf", obs.stamp, t["tf2_msgs/msg/TFMessage"](transforms=transforms))
         self._add_truth(truth)
 
     def _add_scan(self, scan: LaserScan, base: Pose2D) -> None:

@@ -38,7 +38,7 @@ from typing import Literal
 import numpy as np
 import pybullet as p
 
-from pfctl.backends.pybullet.camera import SimCamera
+from pfctl.backends.pybullet.camera import SimCamera, camera_pose
 from pfctl.backends.pybullet.head import HeadServo
 from pfctl.backends.pybullet.laser import BulletLaser, FastLaser, LaserSpec
 from pfctl.backends.pybullet.navigation import Navigator
@@ -357,7 +357,15 @@ class SimRobot:
         if self.camera is not None and self.time >= self._next_frame - eps:
             if not synced:
                 self._sync_bodies()
-            self._frame = self.camera.render(self.pose, self.head.state, self.time)
+            frame = self.camera.render(self.pose, self.head.state, self.time)
+            # Rendered from the true pose, posed where the robot believes its camera is (as the
+            # scans are), so that laser and camera positions agree in the follower's map frame.
+            cam = self.mission.sensors.camera
+            position, rotation = camera_pose(
+                self.localized_pose, self.head.state, cam.mount_height, cam.forward_offset
+            )
+            x, y, z = (float(v) for v in position)
+            self._frame = replace(frame, camera_position=(x, y, z), camera_rotation=rotation)
             period = 1.0 / self.mission.sensors.camera.rate_hz
             while self._next_frame <= self.time + eps:
                 self._next_frame += period
