@@ -3,6 +3,7 @@ laser + camera fusion, and fields of view. Synthetic, seeded detections."""
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -23,7 +24,7 @@ DT = 1.0 / 40.0
 ALL_AROUND = FieldOfView(Pose2D(0.0, 0.0, 0.0), math.pi, 0.0, 50.0)
 
 
-def laser_scan(ranges: np.ndarray | None = None, pose: Pose2D = Pose2D(0.0, 0.0, 0.0)) -> LaserScan:
+def laser_scan(ranges: np.ndarray | None = None, pose: Pose2D | None = None) -> LaserScan:
     """A 270° scan at 0.25° (1081 beams), nothing in range unless ``ranges`` says so."""
     n = 1081
     return LaserScan(
@@ -33,7 +34,7 @@ def laser_scan(ranges: np.ndarray | None = None, pose: Pose2D = Pose2D(0.0, 0.0,
         range_min=0.05,
         range_max=20.0,
         ranges=np.full(n, np.inf) if ranges is None else ranges,
-        pose=pose,
+        pose=pose or Pose2D(0.0, 0.0, 0.0),
     )
 
 
@@ -116,9 +117,9 @@ def test_track_leaving_the_laser_view_coasts_and_comes_back_with_its_id() -> Non
         visible = fov.contains(truth)
         points = [tuple(np.array(truth) + rng.normal(0, 0.03, 2))] if visible else []
         ids = tracker.update(LASER, dets(points), fov, t)
-        if the_id is None and ids and (tr := tracker.track(ids[0])) is not None:
-            if tr.status is TrackStatus.CONFIRMED:
-                the_id = tr.id
+        tr = tracker.track(ids[0]) if the_id is None and ids else None
+        if tr is not None and tr.status is TrackStatus.CONFIRMED:
+            the_id = tr.id
         if the_id is not None and not visible:
             track = tracker.track(the_id)
             assert track is not None, "a track out of view must coast, not vanish"
@@ -140,12 +141,12 @@ def test_coasting_covariance_grows() -> None:
     tracker = MultiPersonTracker(TrackerParams())
     the_id = confirmed_person(tracker, (1.0, 1.0))
     traces = []
-    for k in range(1, 20):
+    for _ in range(20):
         tracker.predict(tracker.time + DT)
         track = tracker.track(the_id)
         assert track is not None
         traces.append(float(np.trace(track.covariance)))
-    assert all(b > a for a, b in zip(traces, traces[1:], strict=False))
+    assert all(b > a for a, b in itertools.pairwise(traces))
 
 
 def test_track_in_view_but_unseen_is_deleted_after_max_coast_s() -> None:
