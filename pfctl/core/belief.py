@@ -1,0 +1,331 @@
+"""The human belief grid of Kim et al. (§II-E, Eq. 4): p(human in cell) over the map.
+
+Every cell holds the probability ``P(h)`` that a person is in it, starting at the ``prior``. When
+the camera delivers a frame, the cells it can see — inside its field of view on the floor and not
+hidden behind a wall or furniture (:func:`visible_mask`) — get a Bayes update with the detector's
+outcome: the cells within ``detection_radius`` of a detected person with ``o`` (person observed),
+every other visible cell with ``¬o``. Cells the camera cannot see keep their value, apart from an
+optional slow exponential decay toward the prior (``decay_per_s``, 0 = off), so that a room looked
+at long ago becomes worth a look again. The gaze controller looks at :meth:`HumanBelief.argmax` /
+:meth:`HumanBelief.most_likely`.
+
+**Eq. 4, corrected.** The update is Bayes' rule for the binary event h (a human in the cell)::
+
+    P(h | o)  =        P(o | h) P(h)        / (P(o | h) P(h) + P(o | hᶜ) P(hᶜ))
+    P(h | ¬o) = (1 − P(o | h)) P(h)        / ((1 − P(o | h)) P(h) + (1 − P(o | hᶜ)) P(hᶜ))
+
+with ``P(hᶜ) = 1 − P(h)``. **The paper prints P(o) in the numerator of Eq. 4; it must be P(h)**
+(with P(o) the numerator would not even depend on the cell's belief, and the two posteriors of a
+cell would not sum to one). The result is clipped to ``[p_min, p_max]`` so that no cell ever
+locks at 0 or 1 and a person can always be found (or lost) again.
+
+**Visibility.** :func:`visible_mask` casts rays across the wedge of a
+:class:`~pfctl.core.tracking.FieldOfView` (angular step the finer of 0.5° and one cell at the far
+range, samples at half-cell steps), finds where each ray first meets a blocked cell, and marks a
+cell visible when it lies in the wedge, between ``range_min`` and ``range_max`` (horizontal
+distance from the camera, depth-limited), and nearer than the first blocked cell along its
+nearest ray. Everything is vectorised and confined to the wedge's bounding box.
+
+Cells outside ``walkable`` (walls, furniture, outside the house) hold probability 0 and are never
+updated, so the belief's maxima are always places where a person can stand.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from pfctl.core.grid import GridGeometry
+from pfctl.core.tracking import FieldOfView
+
+#: Coarsest angle between two visibility rays, radians (finer when a cell at the far range is
+#: narrower than this).
+RAY_STEP = math.radians(0.5)
+
+__all__ = [
+    "RAY_STEP",
+    "BeliefParams",
+    "HumanBelief",
+    "bayes_update",
+    "visible_mask",
+]
+
+
+@dataclass(frozen=True)
+class BeliefParams:
+    """Parameters of Eq. 4 and of the grid's housekeeping (mission ``belief``).
+
+    The first four fields are the mission's ``belief`` section by name, so
+    ``BeliefParams(**mission.belief.model_dump())`` builds them.
+    """
+
+    prior: float = 0.05
+    """P(h) of a cell nobody has looked at."""
+    p_o_given_h: float = 0.9
+    """P(o | h): a person in the cell is detected."""
+    p_o_given_not_h: float = 0.05
+    """P(o | hᶜ): a person is detected although the cell is empty."""
+    decay_per_s: float = 0.0
+    """Rate of the exponential return toward the prior, 1/s (0 = none)."""
+    p_min: float = 0.001
+    p_max: float = 0.999
+    detection_radius: float = 0.3
+    """Cells within this distance of a detected person are updated with o, m."""
+
+    def __post_init__(self) -> None:
+        if not 0.0 < self.p_min < self.p_max < 1.0:
+            raise ValueError(f"need 0 < p_min < p_max < 1, got {self.p_min}, {self.p_max}")
+        if not self.p_min <= self.prior <= self.p_max:
+            raise ValueError(f"prior must lie in [p_min, p_max], got {self.prior}")
+        if not 0.0 <= self.p_o_given_not_h < self.p_o_given_h <= 1.0:
+            raise ValueError(
+                "need 0 ≤ p_o_given_not_h < p_o_given_h ≤ 1, got "
+                f"{self.p_o_given_not_h}, {self.p_o_given_h}"
+            )
+        if not (self.decay_per_s >= 0.0 and math.isfinite(self.decay_per_s)):
+            raise ValueError(f"decay_per_s must be ≥ 0, got {self.decay_per_s}")
+        if not self.detection_radius >= 0.0:
+            raise ValueError(f"detection_radius must be ≥ 0, got {self.detection_radius}")
+
+
+def bayes_update(
+    p_h: ArrayLike, observed: bool | ArrayLike, p_o_given_h: float, p_o_given_not_h: float
+) -> NDArray[np.float64]:
+    """Eq. 4 (corrected: P(h), not P(o), in the numerator): the posterior P(h | o) where
+    ``observed`` is true and P(h | ¬o) where it is false, elementwise, unclipped."""
+    p = np.asarray(p_h, dtype=float)
+    obs = np.asarray(observed, dtype=bool)
+    like_h = np.where(obs, p_o_given_h, 1.0 - p_o_given_h)
+    like_not_h = np.where(obs, p_o_given_not_h, 1.0 - p_o_given_not_h)
+    num = like_h * p
+    return num / (num + like_not_h * (1.0 - p))
+
+
+def _window(geometry: GridGeometry, fov: FieldOfView) -> tuple[int, int, int, int, float] | None:
+    """Rows ``[r0, r1)`` and columns ``[c0, c1)`` of the grid that hold the wedge, and its
+    effective far range (``range_max`` clipped to the grid); None if the wedge misses the grid."""
+    ox, oy = geometry.origin
+    res = geometry.resolution
+    x0, y0 = fov.origin.x, fov.origin.y
+    corners = [
+        (ox, oy),
+        (ox + geometry.width * res, oy),
+        (ox, oy + geometry.height * res),
+        (ox + geometry.width * res, oy + geometry.height * res),
+    ]
+    far = min(fov.range_max, max(math.dist((x0, y0), c) for c in corners))
+    if fov.half_angle >= math.pi:
+        xs, ys = [x0 - far, x0 + far], [y0 - far, y0 + far]
+    else:
+        angles = [fov.origin.theta - fov.half_angle, fov.origin.theta + fov.half_angle]
+        for k in range(4):  # the arc's extreme points where it crosses an axis direction
+            a = k * math.pi / 2
+            if abs(math.remainder(a - fov.origin.theta, 2 * math.pi)) <= fov.half_angle:
+                angles.append(a)
+        xs = [x0] + [x0 + far * math.cos(a) for a in angles]
+        ys = [y0] + [y0 + far * math.sin(a) for a in angles]
+    c0 = max(0, math.floor((min(xs) - ox) / res))
+    c1 = min(geometry.width, math.floor((max(xs) - ox) / res) + 1)
+    r0 = max(0, math.floor((min(ys) - oy) / res))
+    r1 = min(geometry.height, math.floor((max(ys) - oy) / res) + 1)
+    if r0 >= r1 or c0 >= c1:
+        return None
+    return r0, r1, c0, c1, far
+
+
+def _visible_window(
+    geometry: GridGeometry, fov: FieldOfView, blocked: NDArray[np.bool_] | None
+) -> tuple[tuple[int, int, int, int], NDArray[np.bool_]] | None:
+    """The visible cells inside the wedge's bounding box: ``((r0, r1, c0, c1), mask)``."""
+    window = _window(geometry, fov)
+    if window is None:
+        return None
+    r0, r1, c0, c1, far = window
+    res = geometry.resolution
+    x = geometry.origin[0] + (np.arange(c0, c1) + 0.5) * res - fov.origin.x
+    y = geometry.origin[1] + (np.arange(r0, r1) + 0.5) * res - fov.origin.y
+    dx, dy = x[None, :], y[:, None]
+    dist = np.hypot(dx, dy)
+    bearing = np.arctan2(dy, dx) - fov.origin.theta
+    bearing = (bearing + np.pi) % (2.0 * np.pi) - np.pi
+    half = min(fov.half_angle, math.pi)
+    mask = (dist >= fov.range_min) & (dist <= fov.range_max) & (np.abs(bearing) <= half)
+    if blocked is None:
+        return (r0, r1, c0, c1), mask
+
+    # Rays across the wedge, sampled every half cell out to the far range.
+    step = min(RAY_STEP, res / max(far, res))
+    n_rays = max(2, math.ceil(2.0 * half / step) + 1)
+    ray_step = 2.0 * half / (n_rays - 1)
+    ray_angles = fov.origin.theta - half + ray_step * np.arange(n_rays)
+    s = np.arange(0.0, far + res, res / 2.0)
+    px = fov.origin.x + np.cos(ray_angles)[:, None] * s[None, :]
+    py = fov.origin.y + np.sin(ray_angles)[:, None] * s[None, :]
+    cols = np.floor((px - geometry.origin[0]) / res).astype(np.intp)
+    rows = np.floor((py - geometry.origin[1]) / res).astype(np.intp)
+    inside = (rows >= 0) & (rows < geometry.height) & (cols >= 0) & (cols < geometry.width)
+    hit = ~inside  # leaving the grid ends a ray too
+    hit[inside] = blocked[rows[inside], cols[inside]]
+    first = np.where(hit.any(axis=1), hit.argmax(axis=1), len(s))
+    free = np.append(s, np.inf)[first]  # distance to the first blocked sample per ray
+
+    ray = np.rint((bearing + half) / ray_step).astype(np.intp)
+    np.clip(ray, 0, n_rays - 1, out=ray)
+    mask &= dist < free[ray]
+    mask &= ~blocked[r0:r1, c0:c1]
+    return (r0, r1, c0, c1), mask
+
+
+def visible_mask(
+    geometry: GridGeometry, fov: FieldOfView, blocked: ArrayLike | None = None
+) -> NDArray[np.bool_]:
+    """Cells (shape ``geometry.shape``) the sensor of ``fov`` can see: inside the wedge and its
+    range interval, and in front of the first cell of ``blocked`` (walls, furniture; same shape,
+    True = blocks the line of sight) along the line of sight. Blocked cells are never visible."""
+    blocked_arr = None if blocked is None else _blocked(geometry, blocked)
+    out = np.zeros(geometry.shape, dtype=bool)
+    got = _visible_window(geometry, fov, blocked_arr)
+    if got is not None:
+        (r0, r1, c0, c1), mask = got
+        out[r0:r1, c0:c1] = mask
+    return out
+
+
+def _blocked(geometry: GridGeometry, blocked: ArrayLike) -> NDArray[np.bool_]:
+    arr = np.asarray(blocked, dtype=bool)
+    if arr.shape != geometry.shape:
+        raise ValueError(f"blocked mask has shape {arr.shape}, the grid is {geometry.shape}")
+    return arr
+
+
+class HumanBelief:
+    """The human belief grid of Eq. 4 over a map (Kim et al., §II-E).
+
+    ``blocked`` (True = blocks the camera's line of sight, e.g. the occupied cells of the static
+    map) defaults to nothing; ``walkable`` (where a person can be) defaults to ``~blocked``. The
+    probabilities are :attr:`p` (shape ``geometry.shape``, row = y, column = x as in
+    :mod:`pfctl.core.grid`); cells that are not walkable stay 0.
+    """
+
+    def __init__(
+        self,
+        geometry: GridGeometry,
+        params: BeliefParams | None = None,
+        blocked: ArrayLike | None = None,
+        walkable: ArrayLike | None = None,
+    ) -> None:
+        self.geometry = geometry
+        self.params = params or BeliefParams()
+        self.blocked = None if blocked is None else _blocked(geometry, blocked).copy()
+        if walkable is not None:
+            self.walkable = _blocked(geometry, walkable).copy()
+        elif self.blocked is not None:
+            self.walkable = ~self.blocked
+        else:
+            self.walkable = np.ones(geometry.shape, dtype=bool)
+        self.p: NDArray[np.float64] = np.where(self.walkable, self.params.prior, 0.0)
+        self.time: float | None = None
+
+    def reset(self) -> None:
+        """Back to the prior everywhere (the clock is kept)."""
+        self.p = np.where(self.walkable, self.params.prior, 0.0)
+
+    def advance(self, t: float) -> None:
+        """Move the clock to ``t`` (s), decaying every cell toward the prior by
+        ``exp(−decay_per_s · dt)``; an earlier ``t`` is ignored."""
+        if self.time is not None and t > self.time and self.params.decay_per_s > 0:
+            keep = math.exp(-self.params.decay_per_s * (t - self.time))
+            prior = self.params.prior
+            self.p = np.where(self.walkable, prior + (self.p - prior) * keep, 0.0)
+        if self.time is None or t > self.time:
+            self.time = float(t)
+
+    def update(
+        self, fov: FieldOfView, detections: ArrayLike | Sequence[Sequence[float]], t: float
+    ) -> NDArray[np.bool_]:
+        """One camera frame: decay to ``t``, then Eq. 4 on the visible cells — with o within
+        ``detection_radius`` of each detected person (``(n, 2)`` map positions), ¬o elsewhere.
+
+        A detection whose surroundings are all hidden (e.g. a depth just past ``range_max``)
+        still updates its walkable, unblocked cells with o. Returns the visible mask (full grid).
+        """
+        self.advance(t)
+        prm, geo = self.params, self.geometry
+        got = _visible_window(geo, fov, self.blocked)
+        observed = np.zeros(geo.shape, dtype=bool)
+        visible = np.zeros(geo.shape, dtype=bool)
+        if got is not None:
+            (r0, r1, c0, c1), mask = got
+            visible[r0:r1, c0:c1] = mask
+        visible &= self.walkable
+        pts = np.asarray(detections, dtype=float).reshape(-1, 2)
+        res, radius = geo.resolution, prm.detection_radius
+        span = math.ceil(radius / res) + 1
+        for x, y in pts:
+            (row,), (col,) = geo.world_to_cell(np.array([[x, y]]))
+            a0, a1 = max(0, row - span), min(geo.height, row + span + 1)
+            b0, b1 = max(0, col - span), min(geo.width, col + span + 1)
+            if a0 >= a1 or b0 >= b1:
+                continue
+            cx = geo.origin[0] + (np.arange(b0, b1) + 0.5) * res
+            cy = geo.origin[1] + (np.arange(a0, a1) + 0.5) * res
+            near = np.hypot(cx[None, :] - x, cy[:, None] - y) <= max(radius, res / 2)
+            near &= self.walkable[a0:a1, b0:b1]
+            seen = near & visible[a0:a1, b0:b1]
+            if not seen.any() and self.blocked is not None:
+                seen = near & ~self.blocked[a0:a1, b0:b1]
+            elif not seen.any():
+                seen = near
+            observed[a0:a1, b0:b1] |= seen
+        touched = visible | observed
+        if touched.any():
+            post = bayes_update(
+                self.p[touched], observed[touched], prm.p_o_given_h, prm.p_o_given_not_h
+            )
+            self.p[touched] = np.clip(post, prm.p_min, prm.p_max)
+        return visible
+
+    # -------------------------------------------------------------------------------- queries
+
+    def argmax(self) -> tuple[float, float]:
+        """Centre (x, y) of the cell with the highest belief (the first one on ties)."""
+        row, col = np.unravel_index(int(np.argmax(self.p)), self.p.shape)
+        x, y = self.geometry.cell_to_world(row, col)
+        return float(x), float(y)
+
+    def most_likely(self, k: int, min_separation: float = 0.0) -> list[tuple[float, float, float]]:
+        """Up to ``k`` cells ``(x, y, p)`` by decreasing belief, at least ``min_separation`` m
+        apart (greedy: a cell closer than that to an already chosen one is skipped)."""
+        if k <= 0:
+            return []
+        flat = self.p.ravel()
+        pool = max(k, 1) if min_separation <= 0 else min(flat.size, max(64 * k, 1024))
+        pool = min(pool, flat.size)
+        idx = np.argpartition(-flat, pool - 1)[:pool]
+        idx = idx[np.lexsort((idx, -flat[idx]))]  # by belief, then by index: deterministic
+        rows, cols = np.unravel_index(idx, self.p.shape)
+        centres = self.geometry.cell_to_world(rows, cols)
+        out: list[tuple[float, float, float]] = []
+        for (x, y), i in zip(centres, idx, strict=True):
+            if flat[i] <= 0.0:
+                break
+            if min_separation > 0 and any(
+                math.hypot(x - a, y - b) < min_separation for a, b, _ in out
+            ):
+                continue
+            out.append((float(x), float(y), float(flat[i])))
+            if len(out) == k:
+                break
+        return out
+
+    def at(self, xy: ArrayLike) -> NDArray[np.float64]:
+        """The belief at map points ``(..., 2)`` (0 outside the grid)."""
+        rows, cols = self.geometry.world_to_cell(xy)
+        ok = self.geometry.in_bounds(rows, cols)
+        out = np.zeros(np.shape(rows), dtype=float)
+        out[ok] = self.p[rows[ok], cols[ok]]
+        return out
