@@ -5,10 +5,15 @@ model" and associates new detections to tracks "by minimising the total distance
 algorithm). This module is that tracker, with a track life cycle and the fusion of two sensors:
 
 **Filter** (filterpy, named as in the textbook). State ``x = (x, y, ẋ, ẏ)`` in the map frame;
-``F`` is constant velocity over the tick's ``dt``; ``Q`` is the discrete white-noise acceleration
-model with std ``process_noise`` (``filterpy.common.Q_discrete_white_noise``); ``H`` picks the
-position; ``R = σ² I`` per sensor (``laser_noise`` for leg pairs, ``camera_noise`` for RGB-D
-people), so a camera detection moves an estimate less than a laser one.
+``F`` is constant velocity over the tick's ``dt``; ``Q`` is the continuous white-noise
+acceleration model (``filterpy.common.Q_continuous_white_noise``, ``q·[[dt³/3, dt²/2], [dt²/2,
+dt]]`` per axis) with ``q = process_noise²``, so the velocity drifts by ``process_noise`` m/s per
+√s whatever the rate: the 40 Hz laser, the 10 Hz camera and irregular stamps all mean the same
+motion model. (The discrete, piecewise-constant form ``Q_discrete_white_noise`` grows the velocity
+variance by ``σ²·dt`` per second, 40 times less at 40 Hz than at 1 Hz: at the mission's 0.5 and
+40 Hz a person who stops or turns within half a second left the gate and got a new id.) ``H``
+picks the position; ``R = σ² I`` per sensor (``laser_noise`` for leg pairs, ``camera_noise`` for
+RGB-D people), so a camera detection moves an estimate less than a laser one.
 
 **Tick.** :meth:`MultiPersonTracker.update` first predicts every track to the detections' stamp
 (:meth:`~MultiPersonTracker.predict`; irregular ``dt`` from the stamps, ``dt = 0`` allowed, a
@@ -16,13 +21,16 @@ stamp older than the tracker's clock is applied at the clock: no retrodiction). 
 cost matrix of Euclidean distances between predicted positions and detections, forbids every pair
 whose squared Mahalanobis distance ``νᵀ S⁻¹ ν`` with ``S = H P Hᵀ + R`` exceeds ``gate`` (9.21 is
 χ² with 2 dof at 99 %), and solves the assignment with ``scipy.optimize.linear_sum_assignment``
-(the total distance is minimised among the assignments with the most gated pairs). Associated
-tracks are corrected; the other detections start tentative tracks.
+(the total distance is minimised among the assignments with the most gated pairs) — first for
+the confirmed and coasting tracks, then for the tentative ones with the detections left (the
+matching cascade of SORT-style trackers: a young track never takes a known person's detection).
+Associated tracks are corrected; the other detections start tentative tracks.
 
 **Life cycle** (ids are consecutive integers from 1, never reused):
 
 * TENTATIVE → CONFIRMED once it has ``confirm_hits`` detections (the one that created it counts);
-  a tentative track unseen for ``tentative_timeout_s`` is deleted, so clutter never confirms.
+  a tentative track unseen for ``tentative_timeout_s`` is deleted, so a lone spurious detection
+  never confirms (dense random clutter can chain up inside the growing gates: see the benchmark).
 * A confirmed track that a sensor's update does not associate becomes COASTING (prediction only,
   its covariance grows) when the track is inside that sensor's field of view (a miss), or when that
   sensor was the last to see it (it left the view and no other sensor has it). A track outside the
@@ -52,7 +60,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from filterpy.common import Q_discrete_white_noise
+from filterpy.common import Q_continuous_white_noise
 from filterpy.kalman import KalmanFilter
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
@@ -176,7 +184,8 @@ class TrackerParams:
     """
 
     process_noise: float = 0.5
-    """Std of the white-noise acceleration, m/s²."""
+    """White-noise acceleration: √(spectral density), m/s^1.5 — the std of the velocity change
+    over one second (the mission calls it the acceleration std, m/s²; same number)."""
     laser_noise: float = 0.05
     """Std of a laser (leg pair) position, m."""
     camera_noise: float = 0.15
@@ -317,14 +326,18 @@ class MultiPersonTracker:
     # ------------------------------------------------------------------------------- filter
 
     def _motion(self, dt: float) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-        """F and Q (white-noise acceleration) of the constant-velocity model over ``dt``."""
+        """F and Q (continuous white-noise acceleration) of the constant-velocity model."""
         cached = self._motion_cache
         if cached is not None and cached[0] == dt:
             return cached[1], cached[2]
         F = np.eye(4)
         F[0, 2] = F[1, 3] = dt
-        Q = Q_discrete_white_noise(
-            dim=2, dt=dt, var=self.params.process_noise**2, block_size=2, order_by_dim=False
+        Q = Q_continuous_white_noise(
+            dim=2,
+            dt=dt,
+            spectral_density=self.params.process_noise**2,
+            block_size=2,
+            order_by_dim=False,
         )
         self._motion_cache = (dt, F, Q)
         return F, Q
@@ -438,8 +451,9 @@ class MultiPersonTracker:
         return out
 
     def _associate(self, z: NDArray[np.float64], R: NDArray[np.float64]) -> list[tuple[int, int]]:
-        """(track index, detection index) pairs: Hungarian on Euclidean distance, Mahalanobis
-        gate ``νᵀ S⁻¹ ν ≤ gate`` with ``S = H P Hᵀ + R`` (§II-E)."""
+        """(track index, detection index) pairs: Hungarian assignment minimising the total
+        Euclidean distance (§II-E) among pairs inside the Mahalanobis gate ``νᵀ S⁻¹ ν ≤ gate``
+        (``S = H P Hᵀ + R``); confirmed and coasting tracks first, tentative ones get the rest."""
         if not self._entries or len(z) == 0:
             return []
         pos = np.array([e.kf.x[:2] for e in self._entries])
@@ -450,9 +464,23 @@ class MultiPersonTracker:
         gated = d2 <= self.params.gate
         if not gated.any():
             return []
-        cost = np.where(gated, np.hypot(nu[..., 0], nu[..., 1]), _NOT_GATED)
-        rows, cols = linear_sum_assignment(cost)
-        return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if gated[r, c]]
+        dist = np.hypot(nu[..., 0], nu[..., 1])
+        tentative = np.array([e.status is TrackStatus.TENTATIVE for e in self._entries])
+        free = np.ones(len(z), dtype=bool)
+        pairs: list[tuple[int, int]] = []
+        for stage in (~tentative, tentative):
+            rows, cols = np.flatnonzero(stage), np.flatnonzero(free)
+            if len(rows) == 0 or len(cols) == 0:
+                continue
+            ok = gated[np.ix_(rows, cols)]
+            if not ok.any():
+                continue
+            cost = np.where(ok, dist[np.ix_(rows, cols)], _NOT_GATED)
+            for r, c in zip(*linear_sum_assignment(cost), strict=True):
+                if ok[r, c]:
+                    pairs.append((int(rows[r]), int(cols[c])))
+                    free[cols[c]] = False
+        return pairs
 
     # ------------------------------------------------------------------------------- queries
 
