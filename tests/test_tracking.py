@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 import pytest
+from filterpy.common import Q_continuous_white_noise
+from filterpy.kalman import KalmanFilter
 
 from pfctl.core.robot import CameraInfo, LaserScan, Pose2D, RgbdFrame
 from pfctl.core.tracking import (
@@ -18,6 +20,8 @@ from pfctl.core.tracking import (
     MultiPersonTracker,
     TrackerParams,
     TrackStatus,
+    batch_predict,
+    batch_update,
 )
 
 DT = 1.0 / 40.0
@@ -390,3 +394,38 @@ def test_params_validation() -> None:
         TrackerParams(spawn_sensors=("sonar",))
     with pytest.raises(ValueError, match="sensor"):
         MultiPersonTracker().update("sonar", [], ALL_AROUND, 0.0)
+
+
+def test_batched_maths_equals_filterpys_own_predict_and_update() -> None:
+    rng = np.random.default_rng(4)
+
+    def make() -> list[KalmanFilter]:
+        out = []
+        for _ in range(5):
+            kf = KalmanFilter(dim_x=4, dim_z=2)
+            kf.x = rng.normal(0, 2, 4)
+            a = rng.normal(0, 0.3, (4, 4))
+            kf.P = a @ a.T + 0.01 * np.eye(4)
+            kf.H = np.array([[1.0, 0, 0, 0], [0, 1.0, 0, 0]])
+            out.append(kf)
+        return out
+
+    ours = make()
+    rng = np.random.default_rng(4)
+    theirs = make()
+    dt = 0.037
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = dt
+    Q = Q_continuous_white_noise(2, dt, 0.25, block_size=2, order_by_dim=False)
+    R = np.eye(2) * 0.15**2
+    Z = rng.normal(0, 2, (5, 2))
+    batch_predict(ours, F, Q)
+    batch_update(ours, Z, R)
+    for kf, z in zip(theirs, Z, strict=True):
+        kf.predict(F=F, Q=Q)
+        kf.update(z, R=R)
+    for a, b in zip(ours, theirs, strict=True):
+        np.testing.assert_allclose(a.x, b.x, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(a.P, b.P, rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(a.K, b.K, rtol=1e-12, atol=1e-12)
+        assert a.log_likelihood == pytest.approx(b.log_likelihood)

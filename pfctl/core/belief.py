@@ -255,38 +255,48 @@ class HumanBelief:
         """
         self.advance(t)
         prm, geo = self.params, self.geometry
-        got = _visible_window(geo, fov, self.blocked)
-        observed = np.zeros(geo.shape, dtype=bool)
-        visible = np.zeros(geo.shape, dtype=bool)
-        if got is not None:
-            (r0, r1, c0, c1), mask = got
-            visible[r0:r1, c0:c1] = mask
-        visible &= self.walkable
-        pts = np.asarray(detections, dtype=float).reshape(-1, 2)
         res, radius = geo.resolution, prm.detection_radius
         span = math.ceil(radius / res) + 1
+        boxes: list[tuple[int, int, int, int]] = []  # rows [a0, a1), cols [b0, b1) per person
+        pts = np.asarray(detections, dtype=float).reshape(-1, 2)
         for x, y in pts:
             (row,), (col,) = geo.world_to_cell(np.array([[x, y]]))
-            a0, a1 = max(0, row - span), min(geo.height, row + span + 1)
-            b0, b1 = max(0, col - span), min(geo.width, col + span + 1)
+            box = (max(0, row - span), min(geo.height, row + span + 1),
+                   max(0, col - span), min(geo.width, col + span + 1))  # fmt: skip
+            boxes.append(box)
+        got = _visible_window(geo, fov, self.blocked)
+        windows = [b for b in boxes if b[0] < b[1] and b[2] < b[3]]
+        if got is not None:
+            windows.append(got[0])
+        visible = np.zeros(geo.shape, dtype=bool)
+        if not windows:
+            return visible
+        # Work inside the union of the wedge's and the detections' boxes only.
+        r0, r1 = min(w[0] for w in windows), max(w[1] for w in windows)
+        c0, c1 = min(w[2] for w in windows), max(w[3] for w in windows)
+        vis = visible[r0:r1, c0:c1]  # a view: filling it fills ``visible``
+        if got is not None:
+            (a0, a1, b0, b1), mask = got
+            vis[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = mask
+        walkable = self.walkable[r0:r1, c0:c1]
+        vis &= walkable
+        observed = np.zeros(vis.shape, dtype=bool)
+        for (x, y), (a0, a1, b0, b1) in zip(pts, boxes, strict=True):
             if a0 >= a1 or b0 >= b1:
                 continue
             cx = geo.origin[0] + (np.arange(b0, b1) + 0.5) * res
             cy = geo.origin[1] + (np.arange(a0, a1) + 0.5) * res
             near = np.hypot(cx[None, :] - x, cy[:, None] - y) <= max(radius, res / 2)
-            near &= self.walkable[a0:a1, b0:b1]
-            seen = near & visible[a0:a1, b0:b1]
-            if not seen.any() and self.blocked is not None:
-                seen = near & ~self.blocked[a0:a1, b0:b1]
-            elif not seen.any():
-                seen = near
-            observed[a0:a1, b0:b1] |= seen
-        touched = visible | observed
-        if touched.any():
-            post = bayes_update(
-                self.p[touched], observed[touched], prm.p_o_given_h, prm.p_o_given_not_h
-            )
-            self.p[touched] = np.clip(post, prm.p_min, prm.p_max)
+            sub = (slice(a0 - r0, a1 - r0), slice(b0 - c0, b1 - c0))
+            near &= walkable[sub]
+            seen = near & vis[sub]
+            if not seen.any():  # hidden surroundings: trust the detection, not the wedge
+                seen = near if self.blocked is None else near & ~self.blocked[a0:a1, b0:b1]
+            observed[sub] |= seen
+        touched = vis | observed
+        p = self.p[r0:r1, c0:c1]  # a view: updated in place
+        post = bayes_update(p[touched], observed[touched], prm.p_o_given_h, prm.p_o_given_not_h)
+        p[touched] = np.clip(post, prm.p_min, prm.p_max)
         return visible
 
     # -------------------------------------------------------------------------------- queries

@@ -47,7 +47,9 @@ walks behind a wall coasts for ``max_coast_unseen_s`` instead of being dropped a
 ``max_coast_s``. :meth:`FieldOfView.from_frame` is the camera's wedge (horizontal FOV, depth range).
 The human belief grid (:mod:`pfctl.core.belief`) uses the same wedge.
 
-Speed: filterpy's ``predict`` (~3 µs) and ``update`` (~15 µs) per track, gating batched in numpy;
+Speed: every person has a filterpy ``KalmanFilter`` (x, P, F, Q, H, R), but their predict and
+update maths runs for all tracks at once in numpy (:func:`batch_predict`, :func:`batch_update`,
+tested equal to filterpy's own ``predict`` / ``update``); gating is batched too.
 ``benchmarks/bench_tracking_belief.py`` measures a tick with 10 people.
 """
 
@@ -88,6 +90,8 @@ __all__ = [
     "Track",
     "TrackStatus",
     "TrackerParams",
+    "batch_predict",
+    "batch_update",
 ]
 
 
@@ -297,6 +301,53 @@ class _Entry:
 
 
 _H = np.array([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+_I4 = np.eye(4)
+
+
+def batch_predict(
+    filters: Sequence[KalmanFilter], F: NDArray[np.float64], Q: NDArray[np.float64]
+) -> None:
+    """``KalmanFilter.predict(F=F, Q=Q)`` of every filter at once (x ← F x, P ← F P Fᵀ + Q).
+
+    The same maths as filterpy's, batched with numpy: 10 filters in ~15 µs instead of ~35 µs.
+    Sets ``x``, ``P``, ``F``, ``Q`` and the ``x_prior`` / ``P_prior`` copies, as filterpy does.
+    """
+    if not filters:
+        return
+    X = np.array([kf.x for kf in filters]) @ F.T
+    P = F @ np.array([kf.P for kf in filters]) @ F.T + Q
+    for kf, x, cov in zip(filters, X, P, strict=True):
+        kf.x, kf.P, kf.F, kf.Q = x, cov, F, Q
+        kf.x_prior, kf.P_prior = x.copy(), cov.copy()
+
+
+def batch_update(
+    filters: Sequence[KalmanFilter], Z: NDArray[np.float64], R: NDArray[np.float64]
+) -> None:
+    """``KalmanFilter.update(z, R=R)`` of filter ``k`` with measurement ``Z[k]``, all at once.
+
+    filterpy's update with H = [I 0] (position measured): ``y = z − H x``, ``S = H P Hᵀ + R``,
+    ``K = P Hᵀ S⁻¹``, ``x ← x + K y``, and the Joseph form ``P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ``.
+    Sets ``x``, ``P``, ``y``, ``S``, ``SI``, ``K``, ``z``, the ``x_post`` / ``P_post`` copies and
+    clears the cached likelihoods, as filterpy does (``R`` is per call, ``kf.R`` is left alone).
+    About 4 times faster than calling each filter's ``update`` (~15 µs each).
+    """
+    if not filters:
+        return
+    X = np.array([kf.x for kf in filters])
+    P = np.array([kf.P for kf in filters])
+    y = Z - X[:, :2]
+    S = P[:, :2, :2] + R
+    SI = np.linalg.inv(S)
+    K = P[:, :, :2] @ SI  # P Hᵀ S⁻¹, (n, 4, 2)
+    X = X + np.einsum("nij,nj->ni", K, y)
+    IKH = _I4 - K @ _H
+    P = IKH @ P @ IKH.transpose(0, 2, 1) + K @ R @ K.transpose(0, 2, 1)
+    for k, kf in enumerate(filters):
+        kf.x, kf.P, kf.y, kf.S, kf.SI, kf.K = X[k], P[k], y[k], S[k], SI[k], K[k]
+        kf.z = Z[k].copy()
+        kf.x_post, kf.P_post = X[k].copy(), P[k].copy()
+        kf._log_likelihood = kf._likelihood = kf._mahalanobis = None
 
 
 class MultiPersonTracker:
@@ -363,8 +414,8 @@ class MultiPersonTracker:
         dt = float(t) - self._time
         if dt > 0:
             F, Q = self._motion(dt)
-            for entry in self._entries:
-                entry.kf.predict(F=F, Q=Q)
+            filters = [e.kf for e in self._entries]
+            batch_predict(filters, F, Q)
             self._time = float(t)
         self._drop_stale()
 
@@ -398,9 +449,10 @@ class MultiPersonTracker:
         pairs = self._associate(z, R)
         out: list[int | None] = [None] * len(detections)
         associated = set()
+        if pairs:
+            batch_update([self._entries[i].kf for i, _ in pairs], z[[j for _, j in pairs]], R)
         for i, j in pairs:
             entry = self._entries[i]
-            entry.kf.update(z[j], R=R)
             entry.hits += 1
             entry.last_seen = now
             entry.last_seen_by[sensor] = now
