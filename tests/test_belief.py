@@ -153,3 +153,9 @@ def test_params_validation() -> None:
         BeliefParams(p_o_given_h=0.05, p_o_given_not_h=0.05)
     with pytest.raises(ValueError, match="prior"):
         BeliefParams(prior=0.0)
+
+
+def test_params_from_the_mission_by_name() -> None:
+    belief = load_mission(ROOT / "missions" / "house.yaml").belief
+    params = BeliefParams(**belief.model_dump())
+    assert params.prior == belief.prior and params.p_o_given_h == belief.p_o_given_h

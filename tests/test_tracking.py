@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -429,3 +430,12 @@ def test_batched_maths_equals_filterpys_own_predict_and_update() -> None:
         np.testing.assert_allclose(a.P, b.P, rtol=1e-12, atol=1e-12)
         np.testing.assert_allclose(a.K, b.K, rtol=1e-12, atol=1e-12)
         assert a.log_likelihood == pytest.approx(b.log_likelihood)
+
+
+def test_params_from_the_mission_by_name() -> None:
+    from pfctl.mission import load_mission
+
+    root = Path(__file__).resolve().parents[1]
+    tracking = load_mission(root / "missions" / "house.yaml").tracking
+    params = TrackerParams(**tracking.model_dump())
+    assert params.gate == tracking.gate and params.confirm_hits == tracking.confirm_hits
