@@ -1,0 +1,433 @@
+"""Target identification, Algorithm 2 of the paper (§II-E): legs, then face, then clothes.
+
+The paper decides which tracked person is the target by filtering the candidates: first those
+with legs (the laser's leg detector, so a poster or a coat on a chair is not a person), then by
+face (an embedding distance below ``face_distance``), then by clothes (the histogram intersection
+``S = Σ min(I, T) / Σ T`` of :mod:`pfctl.core.clothes` above ``clothes_similarity``).
+
+Faces are trusted most. A face match confirms a track as the target, a face mismatch rejects it
+even if the clothes match (a look-alike in the same shirt); clothes decide only when no face has
+been seen. The paper applies the filter to each frame; here **the decision and its evidence are
+kept per track over time** (:class:`TrackIdentity`), so one good face match carries the track
+through the later frames where the person turns their back, and a mismatching face is remembered
+the same way. When a track has seen faces both ways (a bad detection), the median of its face
+distances decides.
+
+:class:`TargetProfile` is what ``pfctl learn-target`` writes: the target's upper and lower
+clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, saved as a versioned
+``.npz`` (no pickles).
+"""
+
+from __future__ import annotations
+
+import enum
+import io
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from pfctl.core.atomic_files import atomic_write
+from pfctl.core.clothes import (
+    ClothesParams,
+    ColorSpace,
+    body_parts,
+    color_histogram,
+    convert,
+    histogram_intersection,
+)
+from pfctl.core.faces import EMBEDDING_SIZE, Box, FaceEncoder, FaceParams, face_distance
+from pfctl.core.vision import PersonDetection
+from pfctl.errors import UserError
+
+#: Version of the profile file format.
+PROFILE_VERSION = 1
+#: At most this many face embeddings are kept in a profile (spread over the samples).
+MAX_PROFILE_FACES = 32
+#: A head region narrower than this (pixels) is not searched for a face (too far).
+MIN_HEAD_PX = 12
+
+
+@dataclass(frozen=True)
+class IdentityParams:
+    """Thresholds of Algorithm 2 and how appearances are measured (``perception.identity``)."""
+
+    face_distance: float = 0.6
+    """Face-embedding distance below which faces match (dlib's operating point)."""
+    clothes_similarity: float = 0.6
+    """Histogram intersection S at or above which clothes match."""
+    clothes: ClothesParams = field(default_factory=ClothesParams)
+    face: FaceParams = field(default_factory=FaceParams)
+    faces: bool = True
+    """Look for faces at all (False: clothes only, e.g. without dlib's models)."""
+
+
+@dataclass(frozen=True)
+class Appearance:
+    """What one detection looks like: clothing histograms (None when that part was not seen)
+    and the face embedding (None when no face was found)."""
+
+    upper: np.ndarray | None
+    lower: np.ndarray | None
+    face: np.ndarray | None = None
+    face_box: Box | None = None
+
+
+def head_region(detection: PersonDetection) -> Box:
+    """Where to look for the face: the detector's head box (widened by a quarter), else the top
+    quarter of the body box's central 60 %."""
+    if detection.head_box is not None:
+        x0, y0, x1, y1 = detection.head_box
+        mx, my = (x1 - x0) // 4 + 1, (y1 - y0) // 4 + 1
+        return x0 - mx, y0 - my, x1 + mx, y1 + my
+    x0, y0, x1, y1 = detection.box
+    w, h = x1 - x0, y1 - y0
+    return int(x0 + 0.2 * w), y0, math.ceil(x1 - 0.2 * w), int(y0 + 0.25 * h)
+
+
+def describe(
+    rgb: np.ndarray,
+    detection: PersonDetection,
+    params: IdentityParams,
+    encoder: FaceEncoder | None = None,
+    converted: np.ndarray | None = None,
+) -> Appearance:
+    """Measure a detection in ``rgb``: its upper/lower histograms and, with ``encoder``, its
+    best face inside :func:`head_region`. ``converted`` is ``rgb`` already in the clothes'
+    colour space (to convert once per frame for several people)."""
+    shape = rgb.shape[:2]
+    upper_mask, lower_mask = body_parts(
+        shape, detection.box, detection.mask, dict(detection.keypoints or {})
+    )
+    img = converted if converted is not None else convert(rgb, params.clothes.color_space)
+    upper = color_histogram(img, upper_mask, params.clothes, converted=True)
+    lower = color_histogram(img, lower_mask, params.clothes, converted=True)
+    face = face_box = None
+    if encoder is not None and params.faces:
+        region = head_region(detection)
+        if region[2] - region[0] >= MIN_HEAD_PX:
+            faces = encoder.detect(rgb, region)
+            if faces:
+                face, face_box = faces[0].embedding, faces[0].box
+    return Appearance(upper, lower, face, face_box)
+
+
+# -- the target's profile ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TargetProfile:
+    """The target's appearance: normalised upper/lower clothing histograms in ``color_space``
+    with ``bins``, and ``faces`` ``(k, 128)`` embeddings (k may be 0)."""
+
+    upper: np.ndarray
+    lower: np.ndarray
+    faces: np.ndarray
+    color_space: ColorSpace = "hsv"
+    bins: tuple[int, int, int] = (16, 4, 4)
+    frames: int = 0
+    """How many frames the profile was learned from."""
+
+    @property
+    def clothes(self) -> ClothesParams:
+        return ClothesParams(self.color_space, self.bins)
+
+    def face_distance(self, embedding: np.ndarray) -> float | None:
+        """Distance of a face to the target's: the median over the profile's embeddings (robust
+        to a few odd samples in either direction); None if the profile has no face."""
+        if len(self.faces) == 0:
+            return None
+        return float(np.median(face_distance(self.faces, embedding)))
+
+    def similarity(self, appearance: Appearance) -> float | None:
+        """Clothes similarity S of an appearance: the smaller of the upper and lower body's
+        (both must match; a part not seen does not count); None if neither was seen."""
+        s = [
+            histogram_intersection(h, t)
+            for h, t in ((appearance.upper, self.upper), (appearance.lower, self.lower))
+            if h is not None
+        ]
+        return min(s) if s else None
+
+    # .npz I/O ------------------------------------------------------------------------------------
+
+    def to_bytes(self) -> bytes:
+        """The profile as ``.npz`` bytes (version, histograms, faces, colour space, bins)."""
+        buf = io.BytesIO()
+        np.savez(
+            buf,
+            version=np.array(PROFILE_VERSION),
+            upper=np.asarray(self.upper, dtype=np.float64),
+            lower=np.asarray(self.lower, dtype=np.float64),
+            faces=np.asarray(self.faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+            color_space=np.array(self.color_space),
+            bins=np.asarray(self.bins, dtype=np.int64),
+            frames=np.array(self.frames),
+        )
+        return buf.getvalue()
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the profile to ``path`` atomically."""
+        return atomic_write(path, self.to_bytes())
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> TargetProfile:
+        """Read a profile written by :meth:`save`; a bad file is a one-line UserError."""
+        name = str(path)
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                fields = {k: data[k] for k in data.files}
+        except FileNotFoundError:
+            raise UserError(f"{name}: no such target profile") from None
+        except (OSError, ValueError) as err:
+            raise UserError(f"{name}: not a target profile (.npz): {err}") from None
+        missing = {"version", "upper", "lower", "faces", "color_space", "bins"} - set(fields)
+        if missing:
+            raise UserError(f"{name}: not a target profile: missing {', '.join(sorted(missing))}")
+        version = int(fields["version"])
+        if version != PROFILE_VERSION:
+            raise UserError(
+                f"{name}: version: expected {PROFILE_VERSION}, got {version} (learn it again)"
+            )
+        space = str(fields["color_space"])
+        if space not in ("hsv", "rgb", "lab"):
+            raise UserError(f"{name}: color_space: expected hsv, rgb or lab, got {space!r}")
+        bins = tuple(int(b) for b in np.ravel(fields["bins"]))
+        if len(bins) != 3 or min(bins) < 1:
+            raise UserError(f"{name}: bins: expected three positive counts, got {bins}")
+        size = int(np.prod(bins))
+        upper, lower = (np.asarray(fields[k], dtype=np.float64).ravel() for k in ("upper", "lower"))
+        for key, h in (("upper", upper), ("lower", lower)):
+            if h.size != size or not np.all(np.isfinite(h)) or np.any(h < 0):
+                raise UserError(
+                    f"{name}: {key}: expected {size} finite non-negative histogram bins"
+                )
+        faces = np.asarray(fields["faces"], dtype=np.float64)
+        if faces.ndim != 2 or faces.shape[1] != EMBEDDING_SIZE or not np.all(np.isfinite(faces)):
+            raise UserError(f"{name}: faces: expected a (k, {EMBEDDING_SIZE}) array")
+        return cls(
+            upper=upper,
+            lower=lower,
+            faces=faces,
+            color_space=space,  # type: ignore[arg-type]
+            bins=bins,  # type: ignore[arg-type]
+            frames=int(fields.get("frames", 0)),
+        )
+
+    def check_params(self, params: IdentityParams, source: str = "profile") -> None:
+        """A UserError unless the profile's histograms are in the mission's colour space/bins."""
+        want = params.clothes
+        if (self.color_space, tuple(self.bins)) != (want.color_space, tuple(want.bins)):
+            raise UserError(
+                f"{source}: histograms are {self.color_space} {list(self.bins)}, the mission's "
+                f"perception.identity wants {want.color_space} {list(want.bins)} (learn it again)"
+            )
+
+
+def learn_profile(
+    appearances: Sequence[Appearance],
+    params: IdentityParams,
+    max_faces: int = MAX_PROFILE_FACES,
+) -> TargetProfile:
+    """The profile of a person from appearances of them (one per frame): the mean of the
+    normalised histograms (renormalised) and up to ``max_faces`` face embeddings spread evenly
+    over the samples. ValueError if no appearance has both clothing parts."""
+    uppers = [a.upper for a in appearances if a.upper is not None]
+    lowers = [a.lower for a in appearances if a.lower is not None]
+    if not uppers or not lowers:
+        raise ValueError("no appearance shows both the upper and the lower body")
+
+    def mean(hs: list[np.ndarray]) -> np.ndarray:
+        m = np.mean(hs, axis=0)
+        return m / m.sum()
+
+    faces = [a.face for a in appearances if a.face is not None]
+    if len(faces) > max_faces:
+        keep = np.linspace(0, len(faces) - 1, max_faces).round().astype(int)
+        faces = [faces[i] for i in keep]
+    return TargetProfile(
+        upper=mean(uppers),
+        lower=mean(lowers),
+        faces=np.array(faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+        color_space=params.clothes.color_space,
+        bins=params.clothes.bins,
+        frames=len(appearances),
+    )
+
+
+# -- per-track decisions -------------------------------------------------------------------------
+
+
+class Decision(enum.Enum):
+    """What Algorithm 2 concludes about a track."""
+
+    TARGET = "target"
+    NOT_TARGET = "not_target"
+    UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class TrackIdentity:
+    """The evidence gathered about one track and the decision it supports."""
+
+    track_id: int
+    decision: Decision
+    confidence: float
+    """Heuristic 0..1: faces ≥ 0.8, clothes ≤ 0.8, unknown 0."""
+    basis: str
+    """What decided: ``face``, ``clothes``, ``no_legs`` or ``nothing``."""
+    face_distance: float | None
+    """Median face distance to the profile over the track's face samples (None: no face yet)."""
+    best_face_distance: float | None
+    clothes_similarity: float | None
+    """Mean clothes similarity S over the track's observations (None: never measured)."""
+    face_samples: int
+    clothes_samples: int
+    observations: int
+    legs_seen: int
+    last_seen: float
+    face_box: Box | None = None
+    """Where the face was found in the latest observation, if any."""
+
+
+@dataclass
+class _Evidence:
+    face_distances: list[float] = field(default_factory=list)
+    clothes: list[float] = field(default_factory=list)
+    observations: int = 0
+    legs_seen: int = 0
+    last_seen: float = -math.inf
+
+
+class TargetIdentifier:
+    """Algorithm 2 over time: feed each track's observations, ask which track is the target.
+
+    ``observe(track_id, t, has_legs, detection, rgb)`` adds one observation of a track (the
+    detection associated with it in this frame, or None when the camera did not see it) and
+    returns the track's current :class:`TrackIdentity`. A track is a candidate only once the leg
+    detector has confirmed it (``has_legs``) at least once.
+    """
+
+    def __init__(
+        self,
+        profile: TargetProfile,
+        params: IdentityParams | None = None,
+        encoder: FaceEncoder | None = None,
+    ) -> None:
+        self.params = params or IdentityParams(clothes=profile.clothes)
+        profile.check_params(self.params)
+        self.profile = profile
+        use_faces = self.params.faces and len(profile.faces) > 0
+        self.encoder = (encoder or FaceEncoder(self.params.face)) if use_faces else None
+        self._tracks: dict[int, _Evidence] = {}
+        self._latest: dict[int, TrackIdentity] = {}
+
+    def observe(
+        self,
+        track_id: int,
+        t: float,
+        has_legs: bool,
+        detection: PersonDetection | None,
+        rgb: np.ndarray | None,
+        appearance: Appearance | None = None,
+    ) -> TrackIdentity:
+        """Add one observation of ``track_id`` at time ``t``; the updated identity. Pass
+        ``appearance`` when it is already measured (else it is measured from ``rgb``)."""
+        ev = self._tracks.setdefault(track_id, _Evidence())
+        ev.observations += 1
+        ev.last_seen = t
+        ev.legs_seen += bool(has_legs)
+        face_box = None
+        if detection is not None and (appearance is not None or rgb is not None):
+            if appearance is None:
+                assert rgb is not None
+                appearance = describe(rgb, detection, self.params, self.encoder)
+            s = self.profile.similarity(appearance)
+            if s is not None:
+                ev.clothes.append(s)
+            if appearance.face is not None and self.encoder is not None:
+                d = self.profile.face_distance(appearance.face)
+                if d is not None:
+                    ev.face_distances.append(d)
+                    face_box = appearance.face_box
+        identity = self._decide(track_id, ev, face_box)
+        self._latest[track_id] = identity
+        return identity
+
+    def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
+        p = self.params
+        face_d = float(np.median(ev.face_distances)) if ev.face_distances else None
+        best = min(ev.face_distances) if ev.face_distances else None
+        clothes = float(np.mean(ev.clothes)) if ev.clothes else None
+        if ev.legs_seen == 0:
+            decision, conf, basis = Decision.UNKNOWN, 0.0, "no_legs"
+        elif face_d is not None:
+            margin = min(1.0, abs(face_d - p.face_distance) / 0.2)
+            decision = Decision.TARGET if face_d < p.face_distance else Decision.NOT_TARGET
+            conf, basis = 0.8 + 0.2 * margin, "face"
+        elif clothes is not None:
+            margin = min(1.0, abs(clothes - p.clothes_similarity) / 0.3)
+            ok = clothes >= p.clothes_similarity
+            decision = Decision.TARGET if ok else Decision.NOT_TARGET
+            conf, basis = 0.5 + 0.3 * margin, "clothes"
+        else:
+            decision, conf, basis = Decision.UNKNOWN, 0.0, "nothing"
+        return TrackIdentity(
+            track_id=track_id,
+            decision=decision,
+            confidence=conf,
+            basis=basis,
+            face_distance=face_d,
+            best_face_distance=best,
+            clothes_similarity=clothes,
+            face_samples=len(ev.face_distances),
+            clothes_samples=len(ev.clothes),
+            observations=ev.observations,
+            legs_seen=ev.legs_seen,
+            last_seen=ev.last_seen,
+            face_box=face_box,
+        )
+
+    def identity(self, track_id: int) -> TrackIdentity | None:
+        """The latest identity of a track (None if never observed or forgotten)."""
+        return self._latest.get(track_id)
+
+    def identities(self) -> dict[int, TrackIdentity]:
+        """The latest identity of every known track."""
+        return dict(self._latest)
+
+    def target_track(self) -> int | None:
+        """The track that is the target: among tracks decided TARGET, a face-confirmed one before
+        a clothes-only one, then the higher confidence, then the most recently seen; None if no
+        track is decided TARGET."""
+        best: tuple[tuple[int, float, float], int] | None = None
+        for tid, ident in self._latest.items():
+            if ident.decision is not Decision.TARGET:
+                continue
+            key = (int(ident.basis == "face"), ident.confidence, ident.last_seen)
+            if best is None or key > best[0]:
+                best = (key, tid)
+        return None if best is None else best[1]
+
+    def forget(self, track_id: int) -> None:
+        """Drop a track's evidence (the tracker deleted it)."""
+        self._tracks.pop(track_id, None)
+        self._latest.pop(track_id, None)
+
+
+__all__ = [
+    "MAX_PROFILE_FACES",
+    "PROFILE_VERSION",
+    "Appearance",
+    "Decision",
+    "IdentityParams",
+    "TargetIdentifier",
+    "TargetProfile",
+    "TrackIdentity",
+    "describe",
+    "head_region",
+    "learn_profile",
+]

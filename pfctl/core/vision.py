@@ -1,0 +1,380 @@
+"""Person detection on the RGB-D camera with 3-D positions (§II-E).
+
+On the HSR the paper detects people with OpenPose and places each in 3-D from the depth of its
+body. Here a detector is anything with ``detect(frame) -> list[PersonDetection]``
+(:class:`PersonDetector`); three implementations:
+
+- :class:`MaskPersonDetector`: the simulator's, from its segmentation mask. It **stands in for
+  OpenPose**: it is told which body ids belong to which person instance (and, optionally, which
+  part each body is) by the backend, so core never imports pybullet.
+- :class:`HogPersonDetector`: OpenCV's built-in HOG + linear SVM people detector (Dalal & Triggs
+  2005, ``cv2.HOGDescriptor_getDefaultPeopleDetector``, nothing to download) for real cameras,
+  with non-maximum suppression.
+- :class:`GivenPersonDetector`: wraps boxes / keypoints from an external pose source (e.g.
+  OpenPose over ROS on the real robot) and adds the 3-D positions.
+
+The 3-D position (:func:`body_position`) is robust: the median of the map-frame 3-D points of
+the body pixels with a valid depth (back-projected with the intrinsics, through the frame's
+camera pose), pushed :data:`BODY_HALF_DEPTH` further along the horizontal line of sight because
+the camera sees the front of the body and the tracker wants its centre.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Literal, Protocol, runtime_checkable
+
+import numpy as np
+
+from pfctl.core.faces import Box
+from pfctl.core.robot import RgbdFrame
+
+#: Half the front-to-back depth of a person's body, metres: a surface point's offset from the
+#: body's centre along the line of sight.
+BODY_HALF_DEPTH = 0.1
+
+Keypoints = Mapping[str, tuple[float, float]]
+"""2-D keypoints ``name -> (u, v)`` in pixels. Names used here (OpenPose BODY_25 spirit):
+``head`` (centre of the head), ``neck``, ``mid_hip``, ``ankles`` (mid-point of the feet)."""
+
+
+@dataclass(frozen=True)
+class PersonDetection:
+    """One person seen in one RGB-D frame."""
+
+    box: Box
+    """Image box ``(x0, y0, x1, y1)`` of the whole body, pixels (``x1``, ``y1`` exclusive)."""
+    position: tuple[float, float, float]
+    """The body's centre in the map frame, metres, from the depth of its pixels."""
+    score: float = 1.0
+    """Detector confidence (HOG: the SVM margin; mask: 1)."""
+    mask: np.ndarray | None = None
+    """``(h, w) bool`` body pixels, when the detector segments."""
+    keypoints: Keypoints | None = None
+    """2-D keypoints, when known (see :data:`Keypoints`)."""
+    head_box: Box | None = None
+    """Where the head is, when the detector knows (faces are searched there)."""
+    instance: int | None = None
+    """The detector's own index of the person (simulator instance), never a name."""
+    ground_truth_name: str | None = field(default=None, compare=False)
+    """GROUND TRUTH (simulator, tests and metrics only): never for the follower's decisions."""
+
+
+@runtime_checkable
+class PersonDetector(Protocol):
+    """Finds people in an RGB-D frame (OpenPose on the HSR, §II-E)."""
+
+    def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        """The people in ``frame`` with their 3-D positions."""
+        ...
+
+
+def horizontal_range(frame: RgbdFrame, detection: PersonDetection) -> float:
+    """Horizontal distance from the camera to the detection, metres."""
+    cx, cy, _ = frame.camera_position
+    return math.hypot(detection.position[0] - cx, detection.position[1] - cy)
+
+
+def pixels_to_map(frame: RgbdFrame, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
+    """Back-project pixels ``(u, v)`` with their depth to map-frame points ``(n, 3)``; pixels
+    without a finite depth are dropped."""
+    z = frame.depth[vs, us].astype(float)
+    ok = np.isfinite(z) & (z > 0)
+    info = frame.info
+    z, u, v = z[ok], us[ok].astype(float), vs[ok].astype(float)
+    cam = np.column_stack(((u - info.cx) * z / info.fx, (v - info.cy) * z / info.fy, z))
+    return cam @ np.asarray(frame.camera_rotation, dtype=float).T + np.asarray(
+        frame.camera_position, dtype=float
+    )
+
+
+def body_position(
+    frame: RgbdFrame, us: np.ndarray, vs: np.ndarray, half_depth: float = BODY_HALF_DEPTH
+) -> tuple[float, float, float] | None:
+    """The body's centre in the map frame from its pixels: the per-axis median of their 3-D
+    points, moved ``half_depth`` away from the camera horizontally; None if no pixel has depth."""
+    pts = pixels_to_map(frame, us, vs)
+    if len(pts) == 0:
+        return None
+    x, y, z = np.median(pts, axis=0)
+    cx, cy, _ = frame.camera_position
+    d = math.hypot(x - cx, y - cy)
+    if d > 1e-6 and half_depth:
+        x += half_depth * (x - cx) / d
+        y += half_depth * (y - cy) / d
+    return float(x), float(y), float(z)
+
+
+def _bbox(us: np.ndarray, vs: np.ndarray) -> Box:
+    return int(us.min()), int(vs.min()), int(us.max()) + 1, int(vs.max()) + 1
+
+
+class MaskPersonDetector:
+    """People from the simulator's segmentation mask; **stands in for OpenPose**.
+
+    ``instances`` maps each PyBullet body id that belongs to a person to that person's instance
+    index (given by the backend; core does not import pybullet). ``parts`` (optional) names what
+    each body is (``head``, ``torso``, ``leg``): then the detection has a ``head_box`` and the
+    keypoints ``head``, ``neck``, ``mid_hip`` and ``ankles``, as a pose estimator would give.
+    ``names`` (optional) adds the GROUND-TRUTH name to each detection, for tests only.
+    A person with fewer than ``min_pixels`` visible pixels or no valid depth is not detected.
+    """
+
+    def __init__(
+        self,
+        instances: Mapping[int, int],
+        parts: Mapping[int, str] | None = None,
+        *,
+        min_pixels: int = 150,
+        names: Mapping[int, str] | None = None,
+    ) -> None:
+        self.instances = dict(instances)
+        self.parts = dict(parts or {})
+        self.min_pixels = int(min_pixels)
+        self.names = dict(names or {})
+        ids = np.array(sorted(self.instances), dtype=np.int64)
+        self._ids = ids
+        self._inst = np.array([self.instances[i] for i in ids], dtype=np.int64)
+
+    def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        """One detection per person instance with at least ``min_pixels`` pixels."""
+        if frame.mask is None:
+            raise ValueError("MaskPersonDetector needs a frame with a segmentation mask")
+        mask = frame.mask
+        if len(self._ids) == 0:
+            return []
+        # person instance per pixel (-1: none), through a sorted lookup of body ids
+        flat = mask.ravel().astype(np.int64)
+        pos = np.clip(np.searchsorted(self._ids, flat), 0, len(self._ids) - 1)
+        hit = self._ids[pos] == flat
+        inst = np.where(hit, self._inst[pos], -1).reshape(mask.shape)
+        out = []
+        for k in np.unique(inst[inst >= 0]):
+            body = inst == k
+            vs, us = np.nonzero(body)
+            if len(us) < self.min_pixels:
+                continue
+            position = body_position(frame, us, vs)
+            if position is None:
+                continue
+            head_box, keypoints = self._parts_of(mask, body, int(k))
+            out.append(
+                PersonDetection(
+                    box=_bbox(us, vs),
+                    position=position,
+                    score=1.0,
+                    mask=body,
+                    keypoints=keypoints,
+                    head_box=head_box,
+                    instance=int(k),
+                    ground_truth_name=self.names.get(int(k)),
+                )
+            )
+        return out
+
+    def _parts_of(
+        self, mask: np.ndarray, body: np.ndarray, k: int
+    ) -> tuple[Box | None, Keypoints | None]:
+        if not self.parts:
+            return None, None
+        ids = [b for b, i in self.instances.items() if i == k]
+        pix: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+        for part in ("head", "torso", "leg"):
+            sel = np.isin(mask, [b for b in ids if self.parts.get(b) == part]) & body
+            vs, us = np.nonzero(sel)
+            if len(us):
+                pix[part] = (us, vs)
+        keypoints: dict[str, tuple[float, float]] = {}
+        head_box = None
+        if "head" in pix:
+            us, vs = pix["head"]
+            head_box = _bbox(us, vs)
+            keypoints["head"] = (float(np.mean(us)), float(np.mean(vs)))
+        if "torso" in pix:
+            us, vs = pix["torso"]
+            u = float(np.median(us))
+            keypoints["neck"] = (u, float(vs.min()))
+            keypoints["mid_hip"] = (u, float(vs.max()))
+        if "leg" in pix:
+            us, vs = pix["leg"]
+            keypoints["ankles"] = (float(np.median(us)), float(vs.max()))
+        return head_box, keypoints or None
+
+
+def non_max_suppression(boxes: np.ndarray, scores: np.ndarray, overlap: float) -> list[int]:
+    """Indices of the boxes ``(n, 4)`` ``x0, y0, x1, y1`` kept, best first: a box is dropped when
+    its intersection over union with a better kept box exceeds ``overlap``."""
+    order = list(np.argsort(-np.asarray(scores, dtype=float)))
+    keep: list[int] = []
+    b = np.asarray(boxes, dtype=float)
+    area = (b[:, 2] - b[:, 0]) * (b[:, 3] - b[:, 1])
+    while order:
+        i = order.pop(0)
+        keep.append(int(i))
+        rest = []
+        for j in order:
+            w = min(b[i, 2], b[j, 2]) - max(b[i, 0], b[j, 0])
+            h = min(b[i, 3], b[j, 3]) - max(b[i, 1], b[j, 1])
+            inter = max(w, 0.0) * max(h, 0.0)
+            if inter / (area[i] + area[j] - inter) <= overlap:
+                rest.append(j)
+        order = rest
+    return keep
+
+
+def central_pixels(box: Box, shape: tuple[int, int], fraction: float) -> tuple[np.ndarray, ...]:
+    """Pixel coordinates ``(us, vs)`` of the central part of ``box`` (``fraction`` of its
+    width and height), clipped to the image ``shape``."""
+    x0, y0, x1, y1 = box
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    hw, hh = fraction * (x1 - x0) / 2, fraction * (y1 - y0) / 2
+    h, w = shape
+    u0, u1 = max(0, int(cx - hw)), min(w, math.ceil(cx + hw))
+    v0, v1 = max(0, int(cy - hh)), min(h, math.ceil(cy + hh))
+    vs, us = np.mgrid[v0:v1, u0:u1]
+    return us.ravel(), vs.ravel()
+
+
+class GivenPersonDetector:
+    """People from an external source (e.g. OpenPose keypoints over ROS): boxes and optional
+    keypoints are given per frame with :meth:`set`; :meth:`detect` adds the 3-D positions from
+    the median depth of the box's central part."""
+
+    def __init__(self, central_fraction: float = 0.4) -> None:
+        self.central_fraction = central_fraction
+        self._given: list[tuple[Box, Keypoints | None, float]] = []
+
+    def set(self, people: Sequence[tuple[Box, Keypoints | None, float]]) -> None:
+        """The people of the next frame: ``(box, keypoints or None, score)`` each."""
+        self._given = list(people)
+
+    def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        out = []
+        for box, keypoints, score in self._given:
+            us, vs = central_pixels(box, frame.depth.shape, self.central_fraction)
+            position = body_position(frame, us, vs)
+            if position is not None:
+                out.append(PersonDetection(box, position, float(score), keypoints=keypoints))
+        return out
+
+
+class DetectorUnavailableError(RuntimeError):
+    """The person detector asked for cannot run with the installed libraries."""
+
+
+def hog_available() -> bool:
+    """Whether the installed OpenCV has the HOG people detector (OpenCV 4 does, 5.0 does not)."""
+    import cv2
+
+    return hasattr(cv2, "HOGDescriptor") and hasattr(cv2, "HOGDescriptor_getDefaultPeopleDetector")
+
+
+class HogPersonDetector:
+    """OpenCV's HOG people detector (Dalal & Triggs 2005; the default 64x128 linear SVM).
+
+    The image is searched at ``upscale`` (small people in a 320x240 frame need it), boxes are
+    merged by :func:`non_max_suppression`, and each box's position is the median depth of its
+    central part (:data:`central_fraction` of width and height, the torso, not the background).
+    """
+
+    def __init__(
+        self,
+        *,
+        hit_threshold: float = 0.0,
+        upscale: float = 1.0,
+        overlap: float = 0.4,
+        central_fraction: float = 0.3,
+        min_score: float = 0.3,
+    ) -> None:
+        import cv2
+
+        if not hog_available():
+            raise DetectorUnavailableError(
+                f"OpenCV {cv2.__version__} has no HOG people detector (OpenCV 5 moved it out of "
+                "the main package): install opencv-python-headless<5"
+            )
+        self._hog = cv2.HOGDescriptor()
+        self._hog.setSVMDetector(cv2.HOGDescriptor_getDefaultPeopleDetector())
+        self.hit_threshold = hit_threshold
+        self.upscale = upscale
+        self.overlap = overlap
+        self.central_fraction = central_fraction
+        self.min_score = min_score
+
+    def boxes(self, rgb: np.ndarray) -> list[tuple[Box, float]]:
+        """Person boxes in an RGB image with their SVM scores, after suppression, best first."""
+        import cv2
+
+        img = rgb
+        if self.upscale != 1.0:
+            img = cv2.resize(rgb, None, fx=self.upscale, fy=self.upscale)
+        rects, weights = self._hog.detectMultiScale(
+            np.ascontiguousarray(img),
+            hitThreshold=self.hit_threshold,
+            winStride=(8, 8),
+            padding=(8, 8),
+            scale=1.05,
+        )
+        if len(rects) == 0:
+            return []
+        r = np.asarray(rects, dtype=float).reshape(-1, 4) / self.upscale
+        scores = np.asarray(weights, dtype=float).ravel()
+        boxes = np.column_stack((r[:, 0], r[:, 1], r[:, 0] + r[:, 2], r[:, 1] + r[:, 3]))
+        out = []
+        for i in non_max_suppression(boxes, scores, self.overlap):
+            if scores[i] < self.min_score:
+                continue
+            b = boxes[i]
+            out.append(((int(b[0]), int(b[1]), int(b[2]), int(b[3])), float(scores[i])))
+        return out
+
+    def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        out = []
+        for box, score in self.boxes(frame.rgb):
+            us, vs = central_pixels(box, frame.depth.shape, self.central_fraction)
+            position = body_position(frame, us, vs)
+            if position is not None:
+                out.append(PersonDetection(box, position, score))
+        return out
+
+
+def make_detector(
+    kind: Literal["auto", "mask", "hog"],
+    frame: RgbdFrame | None = None,
+    *,
+    instances: Mapping[int, int] | None = None,
+    parts: Mapping[int, str] | None = None,
+    min_pixels: int = 150,
+) -> PersonDetector:
+    """The detector ``VisionConfig.detector`` asks for: ``auto`` is ``mask`` when ``frame`` has
+    a segmentation mask and ``instances`` are known, else ``hog``. ``mask`` without
+    ``instances`` is a ValueError."""
+    if kind == "auto":
+        has_mask = frame is not None and frame.mask is not None
+        kind = "mask" if has_mask and instances is not None else "hog"
+    if kind == "mask":
+        if instances is None:
+            raise ValueError("the mask detector needs the body id -> person instance mapping")
+        return MaskPersonDetector(instances, parts, min_pixels=min_pixels)
+    return HogPersonDetector()
+
+
+__all__ = [
+    "BODY_HALF_DEPTH",
+    "DetectorUnavailableError",
+    "GivenPersonDetector",
+    "HogPersonDetector",
+    "Keypoints",
+    "MaskPersonDetector",
+    "PersonDetection",
+    "PersonDetector",
+    "body_position",
+    "central_pixels",
+    "hog_available",
+    "horizontal_range",
+    "make_detector",
+    "non_max_suppression",
+    "pixels_to_map",
+]
