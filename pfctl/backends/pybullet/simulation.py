@@ -249,6 +249,11 @@ class SimRobot:
             odometry=self.odometry,
         )
 
+    def person_instances(self) -> dict[int, int]:
+        """Body id → person instance index, for the mask person detector (the simulator's
+        stand-in for OpenPose); the index is not the person's name."""
+        return self.people_bodies.instances()
+
     def ground_truth(self) -> GroundTruth:
         """The truth now (for metrics and recording; never for the follower's decisions)."""
         head = self.head.state

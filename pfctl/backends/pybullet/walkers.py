@@ -221,6 +221,13 @@ class Walker:
         self._s = 0.0
         self._pause_left = self.pause_s * float(self._rng.uniform(0.5, 1.5))
 
+    def hold(self, x: float, y: float, theta: float) -> None:
+        """Stand still at ``(x, y)`` facing ``theta`` from now on, the route given up (e.g. the
+        target posing in front of the robot for ``pfctl learn-target``)."""
+        self.x, self.y = float(x), float(y)
+        self.theta = (float(theta) + math.pi) % (2 * math.pi) - math.pi
+        self.speed, self._pause_left, self.done = 0.0, 0.0, True
+
     @property
     def paused(self) -> bool:
         return self.done or self._pause_left > 0
