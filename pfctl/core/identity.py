@@ -88,6 +88,14 @@ def head_region(detection: PersonDetection) -> Box:
     return int(x0 + 0.2 * w), y0, math.ceil(x1 - 0.2 * w), int(y0 + 0.25 * h)
 
 
+def _head_cut(detection: PersonDetection, shape: tuple[int, ...]) -> bool:
+    """Whether the detector's head box touches the image border (a cut face embeds badly)."""
+    if detection.head_box is None:
+        return False
+    x0, y0, x1, y1 = detection.head_box
+    return x0 <= 0 or y0 <= 0 or x1 >= shape[1] or y1 >= shape[0]
+
+
 def describe(
     rgb: np.ndarray,
     detection: PersonDetection,
@@ -96,7 +104,8 @@ def describe(
     converted: np.ndarray | None = None,
 ) -> Appearance:
     """Measure a detection in ``rgb``: its upper/lower histograms and, with ``encoder``, its
-    best face inside :func:`head_region`. ``converted`` is ``rgb`` already in the clothes'
+    best face inside :func:`head_region` (not when the head box touches the image border: a cut
+    face embeds badly). ``converted`` is ``rgb`` already in the clothes'
     colour space (to convert once per frame for several people)."""
     shape = rgb.shape[:2]
     upper_mask, lower_mask = body_parts(
@@ -106,7 +115,7 @@ def describe(
     upper = color_histogram(img, upper_mask, params.clothes, converted=True)
     lower = color_histogram(img, lower_mask, params.clothes, converted=True)
     face = face_box = None
-    if encoder is not None and params.faces:
+    if encoder is not None and params.faces and not _head_cut(detection, shape):
         region = head_region(detection)
         if region[2] - region[0] >= MIN_HEAD_PX:
             faces = encoder.detect(rgb, region)
