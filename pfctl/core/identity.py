@@ -63,6 +63,11 @@ class IdentityParams:
     face: FaceParams = field(default_factory=FaceParams)
     faces: bool = True
     """Look for faces at all (False: clothes only, e.g. without dlib's models)."""
+    face_settled: int = 3
+    """A track with this many face samples is settled: its face is looked at again only every
+    ``face_recheck_s`` (an embedding costs ~90 ms on one core; see benchmarks/bench_identity)."""
+    face_recheck_s: float = 1.0
+    """How often a settled track's face is embedded again, seconds."""
 
 
 @dataclass(frozen=True)
@@ -305,6 +310,7 @@ class TrackIdentity:
 @dataclass
 class _Evidence:
     face_distances: list[float] = field(default_factory=list)
+    last_face: float = -math.inf
     clothes: list[float] = field(default_factory=list)
     observations: int = 0
     legs_seen: int = 0
@@ -317,7 +323,9 @@ class TargetIdentifier:
     ``observe(track_id, t, has_legs, detection, rgb)`` adds one observation of a track (the
     detection associated with it in this frame, or None when the camera did not see it) and
     returns the track's current :class:`TrackIdentity`. A track is a candidate only once the leg
-    detector has confirmed it (``has_legs``) at least once.
+    detector has confirmed it (``has_legs``) at least once. Faces are searched on every
+    observation until the track has ``face_settled`` face samples, then every
+    ``face_recheck_s`` (clothes are measured every time).
     """
 
     def __init__(
@@ -353,7 +361,10 @@ class TargetIdentifier:
         if detection is not None and (appearance is not None or rgb is not None):
             if appearance is None:
                 assert rgb is not None
-                appearance = describe(rgb, detection, self.params, self.encoder)
+                settled = len(ev.face_distances) >= self.params.face_settled
+                due = not settled or t - ev.last_face >= self.params.face_recheck_s
+                encoder = self.encoder if due else None
+                appearance = describe(rgb, detection, self.params, encoder)
             s = self.profile.similarity(appearance)
             if s is not None:
                 ev.clothes.append(s)
@@ -361,6 +372,7 @@ class TargetIdentifier:
                 d = self.profile.face_distance(appearance.face)
                 if d is not None:
                     ev.face_distances.append(d)
+                    ev.last_face = t
                     face_box = appearance.face_box
         identity = self._decide(track_id, ev, face_box)
         self._latest[track_id] = identity

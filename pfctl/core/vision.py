@@ -35,6 +35,9 @@ from pfctl.core.robot import RgbdFrame
 #: body's centre along the line of sight.
 BODY_HALF_DEPTH = 0.1
 
+#: Body part names a backend may give the mask detector, and their codes.
+_PARTS = {"head": 1, "torso": 2, "leg": 3}
+
 Keypoints = Mapping[str, tuple[float, float]]
 """2-D keypoints ``name -> (u, v)`` in pixels. Names used here (OpenPose BODY_25 spirit):
 ``head`` (centre of the head), ``neck``, ``mid_hip``, ``ankles`` (mid-point of the feet)."""
@@ -137,6 +140,7 @@ class MaskPersonDetector:
         ids = np.array(sorted(self.instances), dtype=np.int64)
         self._ids = ids
         self._inst = np.array([self.instances[i] for i in ids], dtype=np.int64)
+        self._part = np.array([_PARTS.get(self.parts.get(int(i), ""), 0) for i in ids], np.int8)
 
     def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
         """One detection per person instance with at least ``min_pixels`` pixels."""
@@ -150,6 +154,7 @@ class MaskPersonDetector:
         pos = np.clip(np.searchsorted(self._ids, flat), 0, len(self._ids) - 1)
         hit = self._ids[pos] == flat
         inst = np.where(hit, self._inst[pos], -1).reshape(mask.shape)
+        part = np.where(hit, self._part[pos], 0).reshape(mask.shape)
         out = []
         for k in np.unique(inst[inst >= 0]):
             body = inst == k
@@ -159,10 +164,11 @@ class MaskPersonDetector:
             position = body_position(frame, us, vs)
             if position is None:
                 continue
-            head_box, keypoints = self._parts_of(mask, body, int(k))
+            box = _bbox(us, vs)
+            head_box, keypoints = self._parts_of(part, body, box)
             out.append(
                 PersonDetection(
-                    box=_bbox(us, vs),
+                    box=box,
                     position=position,
                     score=1.0,
                     mask=body,
@@ -175,17 +181,17 @@ class MaskPersonDetector:
         return out
 
     def _parts_of(
-        self, mask: np.ndarray, body: np.ndarray, k: int
+        self, part: np.ndarray, body: np.ndarray, box: Box
     ) -> tuple[Box | None, Keypoints | None]:
         if not self.parts:
             return None, None
-        ids = [b for b, i in self.instances.items() if i == k]
+        x0, y0, x1, y1 = box
+        crop = np.where(body[y0:y1, x0:x1], part[y0:y1, x0:x1], 0)
         pix: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-        for part in ("head", "torso", "leg"):
-            sel = np.isin(mask, [b for b in ids if self.parts.get(b) == part]) & body
-            vs, us = np.nonzero(sel)
+        for name, code in _PARTS.items():
+            vs, us = np.nonzero(crop == code)
             if len(us):
-                pix[part] = (us, vs)
+                pix[name] = (us + x0, vs + y0)
         keypoints: dict[str, tuple[float, float]] = {}
         head_box = None
         if "head" in pix:
