@@ -1,0 +1,231 @@
+"""The leg classifier's file format: a random forest as plain arrays in an ``.npz`` (no pickle).
+
+The paper classifies laser segments with a random forest (§II-E). It is trained with
+scikit-learn's ``RandomForestClassifier`` (``pfctl legs train``) and shipped as numbers only, so
+loading a model never runs code (``np.load(..., allow_pickle=False)``) and inference needs numpy
+alone: :meth:`LegModel.predict_proba` walks every tree for every sample at once, one level per
+step, and averages the leaves' leg probabilities as scikit-learn's ``predict_proba`` does.
+
+File format (``.npz``, version :data:`FORMAT_VERSION`)::
+
+    format            str, "pfctl-leg-forest"
+    version           int64 scalar, FORMAT_VERSION
+    feature_names     str (f,), the feature columns the forest expects (leg_features.FEATURE_NAMES)
+    metadata          str, JSON: data sets, sizes, seed, date, pfctl version, forest parameters
+    roots             int32 (t,), the root node of each tree in the node arrays below
+    depth             int64 scalar, the deepest path of any tree (levels to walk)
+    left, right       int32 (m,), children of each node (global indices); a leaf points to itself
+    feature           int32 (m,), the feature tested at each node (0 at leaves)
+    threshold         float32 (m,), go left when x[feature] <= threshold (+inf at leaves)
+    leaf_probability  float32 (m,), P(leg) at each leaf (the class-1 fraction of its samples)
+
+As in scikit-learn, features are rounded to float32 before they are compared. scikit-learn's
+float64 thresholds are stored as the largest float32 not above them, which splits every float32
+feature value exactly as the float64 threshold does (and halves the file).
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from dataclasses import dataclass
+from io import BytesIO
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from pfctl.core.atomic_files import atomic_write
+from pfctl.errors import UserError
+
+FORMAT = "pfctl-leg-forest"
+FORMAT_VERSION = 1
+
+
+class LegModelError(UserError):
+    """A leg model file that cannot be used (missing, corrupt, foreign, other features)."""
+
+
+_ARRAYS = ("roots", "left", "right", "feature", "threshold", "leaf_probability")
+
+
+@dataclass(frozen=True)
+class LegModel:
+    """A random forest of decision trees over segment features; P(leg) by :meth:`predict_proba`."""
+
+    feature_names: tuple[str, ...]
+    roots: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    feature: np.ndarray
+    threshold: np.ndarray
+    leaf_probability: np.ndarray
+    depth: int
+    metadata: dict[str, Any]
+
+    @property
+    def n_trees(self) -> int:
+        return len(self.roots)
+
+    @property
+    def n_nodes(self) -> int:
+        return len(self.left)
+
+    @classmethod
+    def from_forest(
+        cls, forest: Any, feature_names: tuple[str, ...], metadata: dict[str, Any]
+    ) -> LegModel:
+        """Copy the trees of a fitted ``sklearn.ensemble.RandomForestClassifier`` with classes
+        ``[0, 1]`` (1 = leg) into arrays."""
+        classes = list(getattr(forest, "classes_", []))
+        if classes != [0, 1]:
+            raise ValueError(f"the forest's classes are {classes}, expected [0, 1]")
+        roots, lefts, rights, feats, thrs, probs = [], [], [], [], [], []
+        offset = 0
+        depth = 0
+        for est in forest.estimators_:
+            t = est.tree_
+            m = t.node_count
+            leaf = t.children_left == -1
+            idx = np.arange(m) + offset
+            lefts.append(np.where(leaf, idx, t.children_left + offset))
+            rights.append(np.where(leaf, idx, t.children_right + offset))
+            feats.append(np.where(leaf, 0, t.feature))
+            thrs.append(np.where(leaf, np.inf, t.threshold))
+            value = t.value[:, 0, :]
+            probs.append(value[:, 1] / np.maximum(value.sum(axis=1), 1e-300))
+            roots.append(offset)
+            offset += m
+            depth = max(depth, int(t.max_depth))
+        return cls(
+            feature_names=tuple(feature_names),
+            roots=np.asarray(roots, dtype=np.int32),
+            left=np.concatenate(lefts).astype(np.int32),
+            right=np.concatenate(rights).astype(np.int32),
+            feature=np.concatenate(feats).astype(np.int32),
+            threshold=_float32_floor(np.concatenate(thrs)),
+            leaf_probability=np.concatenate(probs).astype(np.float32),
+            depth=depth,
+            metadata=dict(metadata),
+        )
+
+    def predict_proba(self, features: np.ndarray) -> np.ndarray:
+        """P(leg) ``(n,)`` for feature rows ``(n, f)``: every sample descends every tree at once
+        (``depth`` vectorised steps), then the leaves' probabilities are averaged."""
+        x = np.asarray(features, dtype=np.float32)
+        if x.ndim != 2 or x.shape[1] != len(self.feature_names):
+            raise ValueError(
+                f"expected features of shape (n, {len(self.feature_names)}), got {x.shape}"
+            )
+        n = len(x)
+        if n == 0:
+            return np.empty(0)
+        node = np.broadcast_to(self.roots, (n, self.n_trees)).copy()
+        rows = np.arange(n)[:, None]
+        for _ in range(self.depth):
+            go_left = x[rows, self.feature[node]] <= self.threshold[node]
+            node = np.where(go_left, self.left[node], self.right[node])
+        return self.leaf_probability[node].astype(np.float64).mean(axis=1)
+
+    def to_bytes(self) -> bytes:
+        """The model as ``.npz`` bytes (compressed)."""
+        buf = BytesIO()
+        np.savez_compressed(
+            buf,
+            format=np.array(FORMAT),
+            version=np.array(FORMAT_VERSION, dtype=np.int64),
+            feature_names=np.array(self.feature_names, dtype=str),
+            metadata=np.array(json.dumps(self.metadata, sort_keys=True)),
+            depth=np.array(self.depth, dtype=np.int64),
+            roots=self.roots,
+            left=self.left,
+            right=self.right,
+            feature=self.feature,
+            threshold=self.threshold,
+            leaf_probability=self.leaf_probability,
+        )
+        return buf.getvalue()
+
+    def save(self, path: Path) -> Path:
+        """Write the model to ``path`` atomically (nothing partial on error)."""
+        return atomic_write(path, self.to_bytes())
+
+
+def _float32_floor(values: np.ndarray) -> np.ndarray:
+    """The largest float32 ≤ each float64 value (x32 ≤ t64 ⟺ x32 ≤ floor32(t64))."""
+    v = np.asarray(values, dtype=np.float64)
+    out = v.astype(np.float32)
+    up = out.astype(np.float64) > v
+    out[up] = np.nextafter(out[up], np.float32(-np.inf))
+    return out
+
+
+def read_leg_model(path: Path, expected_features: tuple[str, ...] | None = None) -> LegModel:
+    """Load a model written by :meth:`LegModel.save`.
+
+    Raises :class:`LegModelError` (a :class:`UserError`: one line naming the file) for a
+    missing, corrupt or foreign file, a newer format, or (with ``expected_features``) a model
+    trained on other features.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise LegModelError(f"{path}: no such leg model file (write one with `pfctl legs train`)")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {name: data[name] for name in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
+        raise LegModelError(f"{path}: not a leg model (.npz without pickles): {err}") from None
+    if str(arrays.get("format", "")) != FORMAT:
+        raise LegModelError(f"{path}: not a leg model: the file has no format '{FORMAT}'")
+    try:
+        version = int(arrays["version"])
+        if version > FORMAT_VERSION:
+            raise LegModelError(
+                f"{path}: leg model format {version} is newer than this pfctl reads "
+                f"({FORMAT_VERSION}); upgrade pfctl or retrain with `pfctl legs train`"
+            )
+        names = tuple(str(s) for s in arrays["feature_names"])
+        metadata = json.loads(str(arrays["metadata"]))
+        model = LegModel(
+            feature_names=names,
+            roots=np.asarray(arrays["roots"], dtype=np.int32),
+            left=np.asarray(arrays["left"], dtype=np.int32),
+            right=np.asarray(arrays["right"], dtype=np.int32),
+            feature=np.asarray(arrays["feature"], dtype=np.int32),
+            threshold=np.asarray(arrays["threshold"], dtype=np.float32),
+            leaf_probability=np.asarray(arrays["leaf_probability"], dtype=np.float32),
+            depth=int(arrays["depth"]),
+            metadata=metadata if isinstance(metadata, dict) else {},
+        )
+    except LegModelError:
+        raise
+    except (KeyError, ValueError, TypeError) as err:
+        raise LegModelError(f"{path}: damaged leg model: {err}") from None
+    _check(path, model)
+    if expected_features is not None and model.feature_names != tuple(expected_features):
+        raise LegModelError(
+            f"{path}: the leg model was trained on features {', '.join(model.feature_names)}; "
+            f"this pfctl computes {', '.join(expected_features)} (retrain with `pfctl legs train`)"
+        )
+    return model
+
+
+def _check(path: Path, model: LegModel) -> None:
+    """Refuse node arrays that would index out of bounds or do not line up."""
+    m = model.n_nodes
+    sizes = {len(getattr(model, a)) for a in _ARRAYS[1:]}
+    ok = (
+        sizes == {m}
+        and m > 0
+        and model.n_trees > 0
+        and model.depth >= 0
+        and np.all((model.roots >= 0) & (model.roots < m))
+        and np.all((model.left >= 0) & (model.left < m))
+        and np.all((model.right >= 0) & (model.right < m))
+        and np.all((model.feature >= 0) & (model.feature < max(len(model.feature_names), 1)))
+    )
+    if not ok:
+        raise LegModelError(f"{path}: damaged leg model: inconsistent tree arrays")
+
+
+__all__ = ["FORMAT", "FORMAT_VERSION", "LegModel", "LegModelError", "read_leg_model"]
