@@ -340,7 +340,12 @@ def learn_target(
         float, typer.Option("--seconds", help="With --backend sim: simulated seconds to look.")
     ] = 6.0,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed",
+            help="Sim seed (default: scenario.seed); people's faces depend on it, so use the "
+            "seed you will follow with.",
+        ),
     ] = None,
 ) -> None:
     """Learn the target's clothes and face and write a target profile (.npz)."""

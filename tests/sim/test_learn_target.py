@@ -106,6 +106,26 @@ def test_learn_target_from_a_folder_of_pictures(pictures, tmp_path, capsys, monk
     assert "learned from 3 of 3 frames" in stdout
 
 
+def test_learn_target_from_a_video(pictures, tmp_path, capsys, monkeypatch) -> None:
+    root, _ = pictures
+    crops = [cv2.imread(str(p)) for p in sorted((root / "crops").iterdir())]
+    h, w = max(c.shape[0] for c in crops), max(c.shape[1] for c in crops)
+    video = tmp_path / "alice.avi"
+    writer = cv2.VideoWriter(str(video), cv2.VideoWriter_fourcc(*"MJPG"), 5.0, (w, h))
+    for k in range(9):
+        canvas = np.full((h, w, 3), 128, np.uint8)
+        crop = crops[k % len(crops)]
+        canvas[: crop.shape[0], : crop.shape[1]] = crop
+        writer.write(canvas)
+    writer.release()
+    out = tmp_path / "alice.npz"
+    args = ["learn-target", str(HOUSE), "--from", str(video), "--out", str(out)]
+    code, stdout, stderr = run_cli(args, capsys, monkeypatch)
+    assert code == 0, stderr
+    assert "learned from 9 of 9 frames" in stdout
+    assert len(TargetProfile.load(out).faces) >= 1
+
+
 def test_several_people_need_pick_which_takes_the_nth_from_the_left(pictures) -> None:
     root, boxes = pictures
 
