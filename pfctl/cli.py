@@ -7,6 +7,8 @@ import sys
 import typer
 
 from pfctl import __version__
+from pfctl.commands import learn_target as learn_target_command
+from pfctl.commands import legs as legs_commands
 from pfctl.commands import map as map_commands
 from pfctl.commands import mission as mission_commands
 from pfctl.commands import predict as predict_commands
@@ -26,6 +28,8 @@ app.add_typer(mission_commands.app, name="mission")
 app.add_typer(map_commands.app, name="map")
 app.add_typer(sim_commands.app, name="sim")
 app.add_typer(predict_commands.app, name="predict")
+app.add_typer(legs_commands.app, name="legs")
+app.command("learn-target")(learn_target_command.learn_target)
 
 
 def _version(value: bool) -> None:

@@ -558,7 +558,8 @@ class TrackingConfig(_Model):
     """Noise of the constant-velocity Kalman filters and the association gate (§II-E)."""
 
     process_noise: Positive = 0.5
-    """Std of the white-noise acceleration, m/s²."""
+    """Continuous white-noise acceleration of the constant-velocity model: √(spectral density),
+    i.e. the std of the velocity change over one second (m/s per √s), whatever the sensor rate."""
     laser_noise: Positive = 0.05
     """Std of a leg-pair position, m."""
     camera_noise: Positive = 0.15
