@@ -511,8 +511,10 @@ class LegsConfig(_Model):
     """Segments with fewer returns are not classified."""
     max_range: Positive = 6.0
     """Segments farther from the laser than this are not classified, metres."""
-    pair_distance: Positive = 0.6
-    """Two legs closer than this form one person candidate, metres."""
+    pair_distance: Positive = 0.45
+    """Two legs closer than this form one person candidate, metres. Walking legs are up to
+    ~0.4 m apart at shin height; 0.6 paired the legs of two people passing each other (see
+    tests/sim/test_perception_sim.py)."""
 
     @field_validator("model")
     @classmethod

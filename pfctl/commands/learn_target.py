@@ -51,6 +51,7 @@ from pfctl.core.robot import HeadTarget, Pose2D
 from pfctl.core.vision import HogPersonDetector, PersonDetection, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
+from pfctl.perception_setup import identity_params
 
 if TYPE_CHECKING:
     from pfctl.backends.pybullet.simulation import SimRobot
@@ -68,16 +69,6 @@ NOD_PERIOD = 2.0
 SWAY = 0.25
 
 BACKENDS = ("sim",)
-
-
-def identity_params(mission: Mission) -> IdentityParams:
-    """The identification parameters of a mission's ``perception.identity``."""
-    cfg = mission.perception.identity
-    return IdentityParams(
-        face_distance=float(cfg.face_distance),
-        clothes_similarity=float(cfg.clothes_similarity),
-        clothes=ClothesParams(cfg.color_space, tuple(int(b) for b in cfg.bins)),  # type: ignore[arg-type]
-    )
 
 
 @dataclass
@@ -486,4 +477,4 @@ def _report(profile: TargetProfile, learned: Learned, out: Path, plot: Path | No
     console.print(f"wrote {out}" + (f" and {plot}" if plot is not None else ""))
 
 
-__all__ = ["identity_params", "learn_from_images", "learn_in_sim", "learn_target", "stand_in_front"]
+__all__ = ["learn_from_images", "learn_in_sim", "learn_target", "stand_in_front"]

@@ -13,7 +13,7 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import identity_params, learn_in_sim
+from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.faces import FaceEncoder, face_distance
 from pfctl.core.identity import Decision, TargetIdentifier, describe, learn_profile
 from pfctl.core.robot import HeadTarget, RgbdFrame
@@ -24,6 +24,7 @@ from pfctl.core.vision import (
     hog_available,
 )
 from pfctl.mission import Mission, loads_mission
+from pfctl.perception_setup import identity_params
 
 ROBOT = (1.0, 3.0)  # facing +x
 

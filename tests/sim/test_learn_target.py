@@ -13,13 +13,14 @@ from conftest import run_cli
 from rich.progress import Progress
 
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import identity_params, learn_from_images
+from pfctl.commands.learn_target import learn_from_images
 from pfctl.core.clothes import histogram_intersection
 from pfctl.core.identity import TargetProfile, learn_profile
 from pfctl.core.robot import HeadTarget
 from pfctl.core.vision import MaskPersonDetector
 from pfctl.errors import UserError
 from pfctl.mission import load_mission, loads_mission
+from pfctl.perception_setup import identity_params
 
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = ROOT / "missions" / "house.yaml"
