@@ -12,6 +12,7 @@ from pfctl.commands import legs as legs_commands
 from pfctl.commands import map as map_commands
 from pfctl.commands import mission as mission_commands
 from pfctl.commands import predict as predict_commands
+from pfctl.commands import replay as replay_command
 from pfctl.commands import sim as sim_commands
 from pfctl.errors import UserError
 
@@ -30,6 +31,7 @@ app.add_typer(sim_commands.app, name="sim")
 app.add_typer(predict_commands.app, name="predict")
 app.add_typer(legs_commands.app, name="legs")
 app.command("learn-target")(learn_target_command.learn_target)
+app.command("replay")(replay_command.replay)
 
 
 def _version(value: bool) -> None:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -12,26 +13,12 @@ from pfctl.perception_setup import build_perception
 
 # Ann and Ben walk X-shaped paths that cross at (5, 3), 4 m in front of the robot; Ben is slower,
 # so he passes the crossing point about 0.6 m behind Ann, partly hidden by her for a moment.
-CROSSING = """
-name: crossing
-map:
-  regions:
-    - {name: hall, polygon: [[0, 0], [10, 0], [10, 6], [0, 6]]}
-robot: {start: {x: 1.0, y: 3.0, theta: 0.0}}
-sensors: {laser: {noise_std: 0.01}}
-scenario:
-  seed: SEED
-  people:
-    - {name: ann, clothes: {upper: [200, 30, 40], lower: [40, 40, 120]}, speed: 0.8,
-       route: [[3.5, 5.0], [6.5, 1.0]]}
-    - {name: ben, clothes: {upper: [30, 120, 200], lower: [60, 60, 60]}, speed: 0.6,
-       route: [[3.5, 1.0], [6.5, 5.0]]}
-"""
+CROSSING = (Path(__file__).parent / "crossing.yaml").read_text()
 
 
 @pytest.mark.parametrize("seed", [2, 3])
 def test_two_people_crossing_paths_keep_their_track_ids(seed: int) -> None:
-    mission = loads_mission(CROSSING.replace("SEED", str(seed)), source="crossing.yaml")
+    mission = loads_mission(CROSSING.replace("seed: 2", f"seed: {seed}"), source="crossing.yaml")
     perception = build_perception(mission)
     owners: dict[str, set[int]] = {"ann": set(), "ben": set()}
     seen_crossing = False
