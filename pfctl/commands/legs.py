@@ -17,14 +17,11 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
 from pfctl.core.leg_model import LegModel
@@ -40,6 +37,8 @@ from pfctl.core.legs import LegParams, load_leg_model
 from pfctl.errors import UserError
 from pfctl.leg_data import count_real_scans, real_dataset, sim_dataset
 from pfctl.mission import Mission, load_mission
+from pfctl.perception_setup import leg_params
+from pfctl.progress import progress_bar
 
 app = typer.Typer(
     help="Laser leg detector: `pfctl legs train`, `pfctl legs evaluate`.",
@@ -59,39 +58,11 @@ def _out() -> Console:
     return Console(width=170, soft_wrap=True)
 
 
-@contextmanager
-def _progress(console: Console, what: str, total: int) -> Iterator[Callable[[int], None]]:
-    """A rich progress bar on stderr (hidden when stderr is not a terminal); yields advance(k)."""
-    bar = Progress(
-        TextColumn(what),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    )
-    with bar:
-        task = bar.add_task(what, total=total)
-        yield lambda k: bar.update(task, advance=k)
-
-
 def _mission(path: Path | None) -> Mission:
     path = path or DEFAULT_MISSION
     if not path.is_file():
         raise UserError(f"--mission {path}: no such mission file")
     return load_mission(path)
-
-
-def _params(mission: Mission) -> LegParams:
-    c = mission.perception.legs
-    return LegParams(
-        probability=c.probability,
-        jump_distance=c.jump_distance,
-        min_points=c.min_points,
-        max_range=c.max_range,
-        pair_distance=c.pair_distance,
-    )
 
 
 def _check_count(value: int, option: str, minimum: int = 0) -> None:
@@ -100,13 +71,13 @@ def _check_count(value: int, option: str, minimum: int = 0) -> None:
 
 
 def _sim(mission: Mission, scans: int, seed: int, params: LegParams, what: str) -> LegDataset:
-    with _progress(_err(), what, scans) as advance:
+    with progress_bar(_err(), what, scans) as advance:
         return sim_dataset(mission, scans, seed, params, advance)
 
 
 def _real(directory: Path, params: LegParams) -> LegDataset:
     total = count_real_scans(directory)
-    with _progress(_err(), f"reading {directory.name}", total) as advance:
+    with progress_bar(_err(), f"reading {directory.name}", total) as advance:
         return real_dataset(directory, params, advance)
 
 
@@ -142,7 +113,7 @@ def train_command(
     if not out.parent.is_dir():
         raise UserError(f"--out {out}: no such folder {out.parent}")
     m = _mission(mission)
-    params = _params(m)
+    params = leg_params(m)
     parts = []
     if sim_scans:
         parts.append(_sim(m, sim_scans, seed, params, "simulating scans"))
@@ -180,7 +151,7 @@ def train_command(
             [f"--sim-scans {sim_scans}", f"--seed {seed}"] + [f"--real {d}" for d in real or []]
         ),
     }
-    with _progress(_err(), "training the forest", 1) as advance:
+    with progress_bar(_err(), "training the forest", 1) as advance:
         model = train_forest(data, seed, metadata=meta)
         advance(1)
     try:
@@ -257,7 +228,7 @@ def evaluate_command(
     """Precision, recall and F1 of leg segments per data set (0.5–5 m and all ranges)."""
     _check_count(sim_scans, "--sim-scans", 1)
     m = _mission(mission)
-    params = _params(m)
+    params = leg_params(m)
     leg_model: LegModel = load_leg_model(model)
     err = _err()
     test = _sim(m, sim_scans, seed + TEST_SEED_OFFSET, params, "simulating test scans")
@@ -277,7 +248,7 @@ def evaluate_command(
             f"{train.scans} simulated scans and the other groups (--model is not used here)"
         )
         total_b = total_a = Score(0, 0, 0, 0)
-        with _progress(err, "cross-validating", len(data.groups)) as advance:
+        with progress_bar(err, "cross-validating", len(data.groups)) as advance:
             for g in data.groups:
                 fold = concat("train", [train, data.without_group(g)])
                 fm = train_forest(fold, seed)

@@ -17,8 +17,7 @@ from __future__ import annotations
 import json
 import math
 import re
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any
@@ -43,6 +42,7 @@ from pfctl.core.walls import rasterize_house
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission
+from pfctl.progress import progress_bar
 
 
 class _PredictGroup(TyperGroup):
@@ -165,23 +165,6 @@ def _load_tracks(
         return read_tracks(data, fmt.value, fps=fps, frame_step=frame_step)
     except TrajectoryFileError as err:
         raise UserError(str(err)) from None
-
-
-@contextmanager
-def _progress(console: Console, what: str, total: int) -> Iterator[Callable[[int], None]]:
-    """A rich progress bar on stderr (hidden when stderr is not a terminal); yields advance(k)."""
-    bar = Progress(
-        TextColumn(what),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    )
-    with bar:
-        task = bar.add_task(what, total=total)
-        yield lambda k: bar.update(task, advance=k)
 
 
 def _json_text(data: Any) -> str:
@@ -469,7 +452,7 @@ def evaluate_command(
         )
     specs = [ModelSpec.of(n, **_mission_params(mission, n)) for n in names]
     err = _err()
-    with _progress(err, "evaluating", len(specs) * len(windows)) as advance:
+    with progress_bar(err, "evaluating", len(specs) * len(windows)) as advance:
         scores = evaluate(specs, windows, jobs=jobs, progress=advance)
     title = f"{data}: {len(windows)} windows of {len(tracks)} tracks, obs {obs}, pred {pred}"
     if fps is not None:

@@ -21,7 +21,6 @@ from typing import Annotated
 import numpy as np
 import typer
 from rich.console import Console
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
 from pfctl.bag_replay import Replay, open_replay
 from pfctl.core.atomic_files import atomic_write_all
@@ -33,6 +32,7 @@ from pfctl.core.vision import HogPersonDetector, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import build_perception
+from pfctl.progress import progress_bar
 
 COLUMNS = ("t", "track_id", "x", "y", "vx", "vy", "confidence", "is_target")
 #: A track unseen for longer than this (s) is drawn with a gap.
@@ -124,19 +124,9 @@ def _run(
     rows: list[Row] = []
     backdrop: list[np.ndarray] = []
     frames = 0
-    bar = Progress(
-        TextColumn("replaying"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-        disable=not console.is_terminal,
-    )
-    with bar:
-        task = bar.add_task("replaying", total=source.total())
+    with progress_bar(console, "replaying", source.total()) as advance:
         for item in source.stream():
-            bar.update(task, advance=1)
+            advance(1)
             if isinstance(item, LaserScan):
                 perception.on_scan(item)
                 target = perception.target()
