@@ -30,13 +30,38 @@ def _one_segment(points: np.ndarray) -> Segments:
     return Segments(points, np.arange(n), np.array([0]), np.array([n]))
 
 
-def test_segmentation_breaks_at_jumps_and_missing_returns() -> None:
+def test_segmentation_breaks_at_jumps_and_skips_missing_returns() -> None:
     inc = math.radians(1.0)
-    r = np.array([2.0, 2.0, 2.0, 3.0, 3.0, np.inf, 3.0, 3.0, 0.0, 3.0, np.nan, 3.0])
+    r = np.array([2.0, 2.0, 2.0, 3.0, 3.0, np.inf, 3.0, 3.0, 0.0, 3.0, np.nan, 3.0, 4.0])
     segs = segment_scan(r, 0.0, inc, 0.05, 20.0, jump_distance=0.13)
-    assert segs.count.tolist() == [3, 2, 2, 1, 1]
-    assert segs.beam.tolist() == [0, 1, 2, 3, 4, 6, 7, 9, 11]
+    # Beams without return are skipped (leg_tracker's clustering), jumps still cut.
+    assert segs.count.tolist() == [3, 6, 1]
+    assert segs.beam.tolist() == [0, 1, 2, 3, 4, 6, 7, 9, 11, 12]
     assert np.allclose(segs.centroids()[0], np.mean(segs.points(0), axis=0))
+
+
+def test_context_features_find_the_other_leg() -> None:
+    # Two small arcs 0.3 m apart (a person's legs), a wide wall far off, a lone 2-point blip.
+    leg = 0.05 * np.column_stack(
+        (np.cos(np.linspace(2.5, 3.8, 6)), np.sin(np.linspace(2.5, 3.8, 6)))
+    )
+    parts = [
+        leg + np.array([2.0, 0.0]),
+        leg + np.array([2.0, 0.3]),
+        np.column_stack((np.full(20, 4.0), np.linspace(1, 3, 20))),
+        np.array([[-2.0, -2.0], [-2.0, -2.01]]),
+    ]
+    xy = np.vstack(parts)
+    count = np.array([len(p) for p in parts])
+    start = np.concatenate(([0], np.cumsum(count)[:-1]))
+    f = segment_features(Segments(xy, np.arange(len(xy)), start, count))
+    assert f[0, F["partner_distance"]] == pytest.approx(0.3)
+    assert f[1, F["partner_distance"]] == pytest.approx(0.3)
+    assert f[0, F["partner_width"]] == pytest.approx(f[1, F["width"]])
+    # The wall is too wide and the blip too short to be a leg; nothing within 3 m of the blip.
+    assert f[3, F["partner_distance"]] == MAX_JUMP
+    assert f[3, F["partner_width"]] == 0.0
+    assert f[:, F["neighbours"]].tolist() == [1, 1, 0, 0]
 
 
 def test_segmentation_of_an_empty_scan() -> None:

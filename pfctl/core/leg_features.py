@@ -3,11 +3,12 @@
 The paper detects legs in the 2-D base laser "from segments of the scan described by geometric
 features and classified by a random forest"; the features are those of Arras, Mozos and Burgard,
 "Using Boosted Features for the Detection of People in 2D Range Data" (ICRA 2007), plus the
-segment's distance from the laser (the point density of a leg falls with range).
+segment's distance from the laser (the point density of a leg falls with range) and three
+features of its surroundings: the nearest other leg-sized segment and the clutter around.
 
 :func:`segment_scan` splits a scan at jumps (Arras et al. 2007, §III-A: "jump distance
 condition"); :func:`segment_features` computes every feature of every segment in one vectorised
-pass (no Python loop over segments), about 0.2 ms for a 1081-beam scan.
+pass (no Python loop over segments), about 0.3 ms for a 1081-beam scan.
 
 All coordinates are in the laser's own frame (x ahead, y left); beams are in scan order (CCW).
 """
@@ -35,12 +36,21 @@ FEATURE_NAMES: tuple[str, ...] = (
     "mean_curvature",
     "mean_angular_difference",
     "distance",
+    "partner_distance",
+    "partner_width",
+    "neighbours",
 )
 
 #: Jumps to a neighbour farther than this (or with no neighbour at all) are reported as this, m.
 MAX_JUMP = 3.0
 #: Fitted circle radii are clipped to this (a straight segment has an unbounded radius), m.
 MAX_RADIUS = 3.0
+#: A possible other leg: a segment of at least this many returns ...
+PARTNER_MIN_POINTS = 3
+#: ... and at most this wide, m.
+PARTNER_MAX_WIDTH = 0.3
+#: ``neighbours`` counts the other segments whose centroid is this close, m.
+NEIGHBOUR_RADIUS = 1.0
 
 
 @dataclass(frozen=True)
@@ -88,9 +98,12 @@ def segment_scan(
     """Split a scan into segments (Arras et al. 2007, §III-A).
 
     Consecutive returns belong to the same segment while the Euclidean distance between them is
-    at most ``jump_distance``; a beam with no return (``inf``, NaN, 0, out of range) always ends
-    the segment. Every return is in exactly one segment (segments of one point included; the
-    detector drops the short ones).
+    below ``jump_distance``; beams with no return (``inf``, NaN, 0, out of range) are skipped,
+    not a break, as in leg_tracker's clustering (Leigh et al. 2015, ``laser_processor.cpp``:
+    real lasers drop single returns on dark cloth, and cutting a leg there gave segments that
+    match only 83 % of the leg clusters labelled in its bags, 97 % when skipped). Every return
+    is in exactly one segment (segments of one point included; the detector drops the short
+    ones).
     """
     r = np.asarray(ranges, dtype=float)
     ok = valid_returns(r, range_min, range_max)
@@ -100,9 +113,8 @@ def segment_scan(
     if len(beam) == 0:
         empty = np.empty(0, dtype=np.intp)
         return Segments(xy, beam, empty, empty)
-    gap = np.diff(beam) > 1
-    jump = np.hypot(*np.diff(xy, axis=0).T) > jump_distance
-    breaks = np.flatnonzero(gap | jump) + 1
+    jump = np.hypot(*np.diff(xy, axis=0).T) >= jump_distance
+    breaks = np.flatnonzero(jump) + 1
     start = np.concatenate(([0], breaks)).astype(np.intp)
     count = np.diff(np.concatenate((start, [len(beam)]))).astype(np.intp)
     return Segments(xy, beam, start, count)
@@ -134,6 +146,18 @@ def segment_features(segments: Segments) -> np.ndarray:
       xᵢ₋₁xᵢ and xᵢxᵢ₊₁ (rad); consistently of one sign for a convex object such as a leg.
     - ``distance`` — range of the centroid from the laser (not in Arras et al.; the point
       density of a leg depends on it).
+    - ``partner_distance`` / ``partner_width`` — distance to the centroid of the nearest other
+      segment that could be a leg (at least :data:`PARTNER_MIN_POINTS` returns, at most
+      :data:`PARTNER_MAX_WIDTH` wide) and that segment's width; :data:`MAX_JUMP` and 0 when
+      there is none. People have two legs a few decimetres apart, which leg trackers use when
+      pairing legs into people (Arras et al. 2007 §V; Leigh et al. 2015 §III); as a feature it
+      lets the forest tell a leg from a lone leg-shaped object.
+    - ``neighbours`` — how many other segments have their centroid within
+      :data:`NEIGHBOUR_RADIUS` (clutter: chair and table legs come in groups).
+
+    On the real leg_tracker bags (a forest on them alone, leave-one-bag-out) these three context
+    features raised precision/recall at P ≥ 0.5 from 0.58/0.29 to 0.75/0.54: most non-legs
+    there are leg-shaped on their own.
 
     Segments of one return get zeros for the shape features; two returns give an undefined
     circle, reported as a zero residual and :data:`MAX_RADIUS`.
@@ -233,6 +257,18 @@ def segment_features(segments: Segments) -> np.ndarray:
         out[:, 11] = np.bincount(tid, weights=curv, minlength=k) / denom
         out[:, 12] = np.bincount(tid, weights=ang, minlength=k) / denom
     out[:, 13] = np.hypot(*c.T)
+
+    # Context: the nearest possible other leg and the clutter around (k × k, k is small).
+    gap = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1])
+    np.fill_diagonal(gap, np.inf)
+    out[:, 16] = np.sum(gap <= NEIGHBOUR_RADIUS, axis=1)
+    legish = (n >= PARTNER_MIN_POINTS) & (out[:, 5] <= PARTNER_MAX_WIDTH)
+    gap[:, ~legish] = np.inf
+    nearest = np.argmin(gap, axis=1)
+    near = gap[np.arange(k), nearest]
+    found = near < MAX_JUMP
+    out[:, 14] = np.where(found, near, MAX_JUMP)
+    out[:, 15] = np.where(found, out[nearest, 5], 0.0)
     return out
 
 
@@ -240,6 +276,9 @@ __all__ = [
     "FEATURE_NAMES",
     "MAX_JUMP",
     "MAX_RADIUS",
+    "NEIGHBOUR_RADIUS",
+    "PARTNER_MAX_WIDTH",
+    "PARTNER_MIN_POINTS",
     "Segments",
     "segment_features",
     "segment_scan",
