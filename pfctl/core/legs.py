@@ -53,7 +53,7 @@ class LegParams:
     """Segments with fewer returns are not classified."""
     max_range: float = 6.0
     """Segments whose centroid is farther from the laser than this are not classified, metres."""
-    pair_distance: float = 0.6
+    pair_distance: float = 0.45
     """Two legs closer than this are one person, metres."""
     single_leg_probability: float = 0.8
     """A leg without a partner is still a person candidate when its P(leg) is at least this."""
