@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from pfctl.bags import LASER_SCAN, POSE_ARRAY, laser_scan, open_bag, pose_array
-from pfctl.core.leg_training import LegDataset, scan_samples
+from pfctl.core.leg_training import IGNORE, LegDataset, ScanSegments, scan_samples, scan_segments
 from pfctl.core.legs import LegParams
 from pfctl.errors import UserError
 from pfctl.mission import Mission
@@ -78,12 +78,21 @@ def count_real_scans(directory: Path) -> int:
     return total
 
 
-def real_dataset(directory: Path, params: LegParams, progress: Progress = _nothing) -> LegDataset:
-    """Labelled segments of every bag in ``directory`` (see the module docstring)."""
+#: One group of real scans in recording order: its name and the segments of each scan.
+ScanSequence = tuple[str, list[ScanSegments]]
+
+
+def real_sequences(
+    directory: Path, params: LegParams, progress: Progress = _nothing
+) -> list[ScanSequence]:
+    """The segments of every scan of every bag in ``directory``, scan by scan, one sequence per
+    group (see the module docstring; unlabelled segments kept as ``IGNORE`` so that evidence
+    over several scans can follow them)."""
     pos, neg = real_bags(directory)
-    data = LegDataset("real")
+    out: list[ScanSequence] = []
     for path in pos:
-        feats, labels, scans = [], [], 0
+        scans: list[ScanSegments] = []
+        arc = LABELLED_ARCS.get(path.name, LABELLED_ARC)
         with open_bag(path) as bag:
             bag.require(SCAN_TOPIC, LASER_SCAN)
             bag.require(LABEL_TOPIC, POSE_ARRAY)
@@ -93,26 +102,34 @@ def real_dataset(directory: Path, params: LegParams, progress: Progress = _nothi
                     positions = pose_array(m.msg).poses[:, :2]
                     continue
                 _, scan = laser_scan(m.msg)
-                arc = LABELLED_ARCS.get(path.name, LABELLED_ARC)
-                f, y = scan_samples(scan, params, positions=positions, labelled_arc=arc)
-                feats.append(f)
-                labels.append(y)
+                scans.append(scan_segments(scan, params, positions=positions, labelled_arc=arc))
                 positions = np.empty((0, 2))  # labels belong to the scan right after them
-                scans += 1
                 progress(1)
-        _add(data, path.name, feats, labels, scans)
+        out.append((path.name, scans))
     for path in neg:
         with open_bag(path) as bag:
             for topic in sorted(t for t, m in bag.topics.items() if m == LASER_SCAN):
-                feats, labels, scans = [], [], 0
+                scans = []
                 for _, scan in bag.scans(topic):
-                    f, y = scan_samples(scan, params)
-                    feats.append(f)
-                    labels.append(y)
-                    scans += 1
+                    scans.append(scan_segments(scan, params))
                     progress(1)
-                _add(data, f"{path.name}:{topic}", feats, labels, scans)
+                out.append((f"{path.name}:{topic}", scans))
+    return out
+
+
+def sequences_dataset(sequences: list[ScanSequence], name: str = "real") -> LegDataset:
+    """The labelled segments of ``sequences`` (``IGNORE`` left out), one group per sequence."""
+    data = LegDataset(name)
+    for group, scans in sequences:
+        feats = [s.features[s.labels != IGNORE] for s in scans]
+        labels = [s.labels[s.labels != IGNORE] == 1 for s in scans]
+        _add(data, group, feats, labels, len(scans))
     return data
+
+
+def real_dataset(directory: Path, params: LegParams, progress: Progress = _nothing) -> LegDataset:
+    """Labelled segments of every bag in ``directory`` (see the module docstring)."""
+    return sequences_dataset(real_sequences(directory, params, progress))
 
 
 def _add(
@@ -142,4 +159,12 @@ def sim_dataset(
     return data
 
 
-__all__ = ["count_real_scans", "real_bags", "real_dataset", "sim_dataset"]
+__all__ = [
+    "ScanSequence",
+    "count_real_scans",
+    "real_bags",
+    "real_dataset",
+    "real_sequences",
+    "sequences_dataset",
+    "sim_dataset",
+]

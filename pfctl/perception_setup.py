@@ -32,6 +32,7 @@ def leg_params(mission: Mission) -> LegParams:
         min_points=c.min_points,
         max_range=c.max_range,
         pair_distance=c.pair_distance,
+        history_scans=c.history_scans,
     )
 
 

@@ -49,6 +49,7 @@ def test_train_writes_a_loadable_model_and_evaluate_prints_the_table(
         (["legs", "evaluate", "--model", "/no/m.npz"], "/no/m.npz: no such leg model file"),
         (["legs", "evaluate", "--sim-scans", "0"], "--sim-scans: expected an integer ≥ 1"),
         (["legs", "evaluate", "--mission", "/no/house.yaml"], "--mission /no/house.yaml"),
+        (["legs", "evaluate", "--history", "0"], "--history: expected an integer ≥ 1, got 0"),
     ],
 )
 def test_bad_inputs_exit_2_with_one_line(

@@ -3,11 +3,13 @@
 - ``pfctl legs train [--sim-scans N] [--real DIR ...] [--seed S] [--out model.npz]``: labelled
   segments of simulated scans (and of real bags), a seeded random forest, written atomically as
   an ``.npz`` (:mod:`pfctl.core.leg_model`).
-- ``pfctl legs evaluate [--model M] [--real DIR] [--sim-scans N] [--seed S]``: precision,
-  recall and F1 of leg segments per data set, at 0.5–5 m and at all ranges: the model on
-  held-out simulated scans (other seeds), and on the real bags cross-validated by bag (for each
-  bag — each topic of a negative bag — a forest trained on the simulated scans and the other
-  bags is tested on it).
+- ``pfctl legs evaluate [--model M] [--real DIR] [--sim-scans N] [--seed S] [--history H]``:
+  precision, recall and F1 of leg segments per data set, at 0.5–5 m and at all ranges: the
+  model on held-out simulated scans (other seeds), and on the real bags cross-validated by bag
+  (for each bag — each topic of a negative bag — a forest trained on the simulated scans and
+  the other bags is tested on it, scan after scan, with P(leg) averaged over ``H`` scans of
+  each segment's track when ``H`` > 1; simulated test scans are independent draws, scored one
+  at a time).
 
 Bad input is a :class:`pfctl.errors.UserError` (one line, exit 2). Tables go to stdout, progress
 and notes to stderr.
@@ -31,11 +33,18 @@ from pfctl.core.leg_training import (
     Score,
     concat,
     evaluate_model,
+    evaluate_sequence,
     train_forest,
 )
 from pfctl.core.legs import LegParams, load_leg_model
 from pfctl.errors import UserError
-from pfctl.leg_data import count_real_scans, real_dataset, sim_dataset
+from pfctl.leg_data import (
+    ScanSequence,
+    count_real_scans,
+    real_sequences,
+    sequences_dataset,
+    sim_dataset,
+)
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import leg_params
 from pfctl.progress import progress_bar
@@ -76,9 +85,13 @@ def _sim(mission: Mission, scans: int, seed: int, params: LegParams, what: str) 
 
 
 def _real(directory: Path, params: LegParams) -> LegDataset:
+    return sequences_dataset(_real_sequences(directory, params))
+
+
+def _real_sequences(directory: Path, params: LegParams) -> list[ScanSequence]:
     total = count_real_scans(directory)
     with progress_bar(_err(), f"reading {directory.name}", total) as advance:
-        return real_dataset(directory, params, advance)
+        return real_sequences(directory, params, advance)
 
 
 def _size_line(data: LegDataset) -> str:
@@ -221,6 +234,14 @@ def evaluate_command(
         Path | None,
         typer.Option("--mission", help="Mission: the house and perception.legs (default: house)."),
     ] = None,
+    history: Annotated[
+        int | None,
+        typer.Option(
+            "--history",
+            help="Real bags: average P(leg) over this many scans of each segment's track "
+            "(default: the mission's perception.legs.history_scans).",
+        ),
+    ] = None,
     json_out: Annotated[
         Path | None, typer.Option("--json", help="Also write the figures as JSON here.")
     ] = None,
@@ -229,6 +250,9 @@ def evaluate_command(
     _check_count(sim_scans, "--sim-scans", 1)
     m = _mission(mission)
     params = leg_params(m)
+    if history is not None:
+        _check_count(history, "--history", 1)
+    scans = params.history_scans if history is None else history
     leg_model: LegModel = load_leg_model(model)
     err = _err()
     test = _sim(m, sim_scans, seed + TEST_SEED_OFFSET, params, "simulating test scans")
@@ -241,23 +265,28 @@ def evaluate_command(
     if real is None:
         err.print("note: no --real DIR given: the real bags are not evaluated")
     else:
-        data = _real(real, params)
+        sequences = dict(_real_sequences(real, params))
+        data = sequences_dataset(list(sequences.items()))
         train = _sim(m, sim_scans, seed, params, "simulating training scans")
         err.print(
             f"real: {len(data.groups)} groups, cross-validated by bag: each fold trains on "
             f"{train.scans} simulated scans and the other groups (--model is not used here)"
+            + (f"; P(leg) averaged over {scans} scans of each segment's track" if scans > 1 else "")
         )
         total_b = total_a = Score(0, 0, 0, 0)
         with progress_bar(err, "cross-validating", len(data.groups)) as advance:
             for g in data.groups:
                 fold = concat("train", [train, data.without_group(g)])
                 fm = train_forest(fold, seed)
-                b, a = evaluate_model(fm, data.only_group(g), params.probability)
+                if scans > 1:
+                    b, a = evaluate_sequence(fm, sequences[g], params.probability, scans)
+                else:
+                    b, a = evaluate_model(fm, data.only_group(g), params.probability)
                 _row(table, f"  {g}", b, a)
                 total_b, total_a = total_b + b, total_a + a
                 advance(1)
         _row(table, f"real {real.name} (all folds)", total_b, total_a)
-        results["real"] = _figures(total_b, total_a)
+        results["real"] = _figures(total_b, total_a) | {"history_scans": scans}
     _out().print(table)
     if json_out is not None:
         from pfctl.core.atomic_files import atomic_write

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from pfctl import __version__
+from pfctl.core.leg_evidence import LegEvidence
 from pfctl.core.leg_features import FEATURE_NAMES, Segments
 from pfctl.core.leg_model import LegModel
 from pfctl.core.legs import LegParams, describe_segments
@@ -143,6 +144,44 @@ def label_by_circles(segments: Segments, pose: Any, circles: np.ndarray) -> np.n
     return share > 0.5
 
 
+@dataclass(frozen=True)
+class ScanSegments:
+    """The segments of one scan that the detector classifies: features ``(k, f)``, labels
+    ``(k,)`` (1 leg, 0 not, :data:`IGNORE` unlabelled) and centroids ``(k, 2)``, laser frame."""
+
+    features: np.ndarray
+    labels: np.ndarray
+    xy: np.ndarray
+
+
+def scan_segments(
+    scan: LaserScan,
+    params: LegParams,
+    circles: np.ndarray | None = None,
+    positions: np.ndarray | None = None,
+    labelled_arc: tuple[float, float, float] | None = None,
+) -> ScanSegments:
+    """Every segment of one scan that the detector would classify (``min_points``,
+    ``max_range``), labelled by true leg ``circles`` (map frame) or labelled leg ``positions``
+    (laser frame; with ``labelled_arc`` ``(min_deg, max_deg, max_range)`` segments whose
+    centroid lies outside the labelled part of the scan are :data:`IGNORE`); with neither,
+    every segment is a non-leg."""
+    segs, feats, ok = describe_segments(scan, params)
+    cen = segs.centroids()
+    if circles is not None:
+        labels = label_by_circles(segs, scan.pose, circles).astype(np.int8)
+    elif positions is not None:
+        labels = label_by_positions(cen, positions)
+        if labelled_arc is not None:
+            lo, hi, far = labelled_arc
+            bearing = np.degrees(np.arctan2(cen[:, 1], cen[:, 0]))
+            inside = (bearing > lo) & (bearing < hi) & (np.hypot(*cen.T) < far)
+            labels[~inside] = IGNORE
+    else:
+        labels = np.zeros(len(segs), dtype=np.int8)
+    return ScanSegments(feats[ok], labels[ok], cen[ok])
+
+
 def scan_samples(
     scan: LaserScan,
     params: LegParams,
@@ -150,26 +189,11 @@ def scan_samples(
     positions: np.ndarray | None = None,
     labelled_arc: tuple[float, float, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Features and labels of the segments of one scan that the detector would classify
-    (``min_points``, ``max_range``): labelled by true leg ``circles`` (map frame) or labelled
-    leg ``positions`` (laser frame; segments labelled :data:`IGNORE` are left out, and with
-    ``labelled_arc`` ``(min_deg, max_deg, max_range)`` so are those whose centroid lies
-    outside the part of the scan that was labelled); with neither, every segment is a non-leg."""
-    segs, feats, ok = describe_segments(scan, params)
-    if circles is not None:
-        labels = label_by_circles(segs, scan.pose, circles)
-    elif positions is not None:
-        cen = segs.centroids()
-        lab = label_by_positions(cen, positions)
-        ok &= lab != IGNORE
-        if labelled_arc is not None:
-            lo, hi, far = labelled_arc
-            bearing = np.degrees(np.arctan2(cen[:, 1], cen[:, 0]))
-            ok &= (bearing > lo) & (bearing < hi) & (np.hypot(*cen.T) < far)
-        labels = lab == 1
-    else:
-        labels = np.zeros(len(segs), dtype=bool)
-    return feats[ok], labels[ok]
+    """Features and boolean labels of the labelled segments of :func:`scan_segments` (those
+    labelled :data:`IGNORE` left out)."""
+    s = scan_segments(scan, params, circles, positions, labelled_arc)
+    keep = s.labels != IGNORE
+    return s.features[keep], s.labels[keep] == 1
 
 
 def train_forest(
@@ -270,16 +294,40 @@ def evaluate_model(model: LegModel, data: LegDataset, threshold: float) -> tuple
     )
 
 
+def evaluate_sequence(
+    model: LegModel, scans: list[ScanSegments], threshold: float, history: int
+) -> tuple[Score, Score]:
+    """(score in :data:`EVAL_BAND`, score at all ranges) of ``model`` on a sequence of scans of
+    one laser, each segment's P(leg) averaged over ``history`` scans of its track
+    (:class:`~pfctl.core.leg_evidence.LegEvidence`, in the laser frame: the bags carry no
+    odometry, so a moving laser's segments are followed only as far as they stay within its
+    radius between scans)."""
+    evidence = LegEvidence(history)
+    labels, prob, dist = [], [], []
+    for s in scans:
+        p = model.predict_proba(s.features) if len(s.features) else np.empty(0)
+        p = evidence.update(s.xy, p)
+        keep = s.labels != IGNORE
+        labels.append(s.labels[keep] == 1)
+        prob.append(p[keep])
+        dist.append(s.features[keep, _DISTANCE])
+    y, pr, d = (np.concatenate(a) if a else np.empty(0) for a in (labels, prob, dist))
+    return score(y, pr, threshold, d, EVAL_BAND), score(y, pr, threshold)
+
+
 __all__ = [
     "EVAL_BAND",
     "LABEL_RADIUS",
     "LegDataset",
+    "ScanSegments",
     "Score",
     "concat",
     "evaluate_model",
+    "evaluate_sequence",
     "label_by_circles",
     "label_by_positions",
     "scan_samples",
+    "scan_segments",
     "score",
     "train_forest",
 ]

@@ -10,7 +10,9 @@ legs close together are one person. Here:
    described by :func:`~pfctl.core.leg_features.segment_features` (Arras et al. 2007, §IV, plus
    the distance from the laser);
 3. the forest (:class:`~pfctl.core.leg_model.LegModel`, trained by ``pfctl legs train``) gives
-   P(leg); segments with P ≥ ``probability`` are legs;
+   P(leg), averaged over the last ``history_scans`` scans of the segment's track when that is
+   more than 1 (:class:`~pfctl.core.leg_evidence.LegEvidence`); segments with P ≥
+   ``probability`` are legs;
 4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
    (greedy matching by distance), into person candidates at the midpoint; a leg left alone
    with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
@@ -29,6 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
+from pfctl.core.leg_evidence import LegEvidence
 from pfctl.core.leg_features import FEATURE_NAMES, Segments, segment_features, segment_scan
 from pfctl.core.leg_model import LegModel, read_leg_model
 from pfctl.core.robot import LaserScan
@@ -57,6 +60,9 @@ class LegParams:
     """Two legs closer than this are one person, metres."""
     single_leg_probability: float = 0.8
     """A leg without a partner is still a person candidate when its P(leg) is at least this."""
+    history_scans: int = 10
+    """P(leg) is the mean over this many scans of the segment's track (1: this scan alone;
+    :class:`~pfctl.core.leg_evidence.LegEvidence`)."""
 
 
 @dataclass(frozen=True)
@@ -162,15 +168,30 @@ def pair_legs(xy: np.ndarray, probability: np.ndarray, params: LegParams) -> lis
 
 
 class LegDetector:
-    """Laser leg detector (§II-E): ``detect(scan)`` → legs and person candidates, map frame."""
+    """Laser leg detector (§II-E): ``detect(scan)`` → legs and person candidates, map frame.
+
+    With ``history_scans`` > 1 it remembers the segments of the previous scans (one detector per
+    laser; :meth:`reset` between unrelated sequences)."""
 
     def __init__(self, model: LegModel, params: LegParams | None = None) -> None:
         self.model = model
         self.params = params or LegParams()
+        self.evidence = (
+            LegEvidence(self.params.history_scans) if self.params.history_scans > 1 else None
+        )
+
+    def reset(self) -> None:
+        """Forget the segments of earlier scans."""
+        if self.evidence is not None:
+            self.evidence.reset()
 
     def detect(self, scan: LaserScan) -> LegDetections:
         """Legs (P ≥ ``probability``) and the people they make in one scan."""
         c = classify_segments(scan, self.model, self.params)
+        if self.evidence is not None:
+            seen = np.flatnonzero(c.classified)
+            where = scan.pose.transform(c.segments.centroids()[seen])
+            c.probability[seen] = self.evidence.update(where, c.probability[seen])
         is_leg = c.classified & (c.probability >= self.params.probability)
         idx = np.flatnonzero(is_leg)
         if len(idx) == 0:
