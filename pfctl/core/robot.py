@@ -242,6 +242,10 @@ class Robot(Protocol):
         """
         ...
 
+    def point_head(self, head: HeadTarget) -> None:
+        """Move the head toward ``head`` only; the base and any navigation goal carry on."""
+        ...
+
     def navigate(self, goal: Pose2D) -> None:
         """Start MOVE_BASE-style navigation to ``goal``; progress through :meth:`nav_status`."""
         ...
