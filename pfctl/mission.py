@@ -50,6 +50,7 @@ from pydantic import (
 from pydantic_core import PydanticCustomError
 from shapely.validation import explain_validity
 
+from pfctl.core.behavior.registry import leaf_spec
 from pfctl.core.house import Door, HouseLayout, Obstacle, Region
 from pfctl.errors import MissionError
 
@@ -59,6 +60,7 @@ __all__ = [
     "CameraConfig",
     "Clothes",
     "Composite",
+    "ControlConfig",
     "Decorator",
     "DoorSpec",
     "LaserConfig",
@@ -667,6 +669,9 @@ class Composite(_Model):
 
     name: str | None = None
     children: Annotated[tuple[TreeNode, ...], Field(min_length=1)]
+    memory: bool = False
+    """False (reactive): every tick starts again at the first child, so a condition is checked
+    again while a later action runs; True: a tick resumes at the child that was running."""
 
 
 class Parallel(Composite):
@@ -743,6 +748,23 @@ class TreeNode(_Model):
         if "params" in data and kinds[0] not in LEAVES:
             raise _fail(("params",), f"params belong to a condition or action leaf, not {kinds[0]}")
         return data
+
+    @model_validator(mode="after")
+    def _known_leaf(self) -> TreeNode:
+        """A leaf names a registered condition or action, with valid parameters."""
+        if self.condition is None and self.action is None:
+            return self
+        kind = "condition" if self.condition is not None else "action"
+        try:
+            spec = leaf_spec(kind, str(self.body))
+        except ValueError as err:
+            raise _fail((kind,), str(err)) from None
+        try:
+            spec.resolve(self.params)
+        except ValueError as err:
+            key, _, reason = str(err).partition(": ")
+            raise _fail(("params", key), reason) from None
+        return self
 
     @property
     def kind(self) -> str:
@@ -838,6 +860,31 @@ def _paper_tree() -> TreeNode:
             }
         }
     )
+
+
+class ControlConfig(_Model):
+    """Gaze and base control while following (§II-E), and what counts as following."""
+
+    following_distance: Annotated[float, Field(ge=0.3), _NO_BOOL] = 1.0
+    """Keep this far from the target, metres."""
+    min_distance: Annotated[float, Field(ge=0.3), _NO_BOOL] = 0.7
+    """Never drive closer than this to a person (base centre to person centre), metres."""
+    turn_threshold: Annotated[float, Field(gt=0, le=3.2), _NO_BOOL] = 0.5
+    """Above this bearing to the target the base turns in place before going straight, rad."""
+    stale_after: Positive = 0.5
+    """The base stops when the laser or the pose is older than this, seconds."""
+    following_band: Limits = (0.5, 2.5)
+    """A tick counts as following when the target is identified and this far away, metres."""
+
+    @model_validator(mode="after")
+    def _distances_ordered(self) -> ControlConfig:
+        if self.min_distance > self.following_distance:
+            raise _fail(
+                ("min_distance",),
+                f"expected min_distance <= following_distance ({self.following_distance:g}), "
+                f"got {self.min_distance:g}",
+            )
+        return self
 
 
 class BehaviorConfig(_Model):
@@ -948,6 +995,7 @@ class Mission(_Model):
     belief: BeliefConfig = BeliefConfig()
     prediction: PredictionConfig = PredictionConfig()
     search: SearchConfig = SearchConfig()
+    control: ControlConfig = ControlConfig()
     behavior: BehaviorConfig = BehaviorConfig()
     scenario: ScenarioConfig = ScenarioConfig()
 
