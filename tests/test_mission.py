@@ -189,7 +189,7 @@ def test_tree_with_decorators_and_parallel() -> None:
         "            children:\n"
         "              - retry: {attempts: 3, child: {action: waypoint_search}}\n"
         "              - timeout:\n"
-        "                  {seconds: 2.5, child: {action: look_around, params: {turns: 2}}}\n"
+        "                  {seconds: 2.5, child: {action: look_around, params: {pan: 2}}}\n"
         "              - inverter: {child: {condition: target_visible}}\n",
     )
     tree = loads_mission(text).behavior.tree
@@ -197,7 +197,7 @@ def test_tree_with_decorators_and_parallel() -> None:
     parallel = tree.children[1]
     assert parallel.kind == "parallel"
     assert [c.kind for c in parallel.children] == ["retry", "timeout", "inverter"]
-    assert parallel.children[1].children[0].params == {"turns": 2}
+    assert parallel.children[1].children[0].params == {"pan": 2}
 
 
 def test_models_are_frozen() -> None:
@@ -207,9 +207,11 @@ def test_models_are_frozen() -> None:
 
 
 def test_tree_node_is_usable_alone() -> None:
-    node = TreeNode.model_validate({"sequence": {"name": "s", "children": [{"action": "go"}]}})
+    node = TreeNode.model_validate({"sequence": {"name": "s", "children": [{"action": "stop"}]}})
     assert node.label == "s"
-    assert node.children[0].body == "go"
+    assert node.children[0].body == "stop"
+    with pytest.raises(ValueError, match="unknown action 'go'"):
+        TreeNode.model_validate({"sequence": {"children": [{"action": "go"}]}})
 
 
 # --------------------------------------------------------------------------------------------
