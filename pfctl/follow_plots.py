@@ -530,10 +530,12 @@ def timeline_figure(
     row 2: the action leaf that ran (:data:`ACTION_COLORS`; ticks without an action are blank);
     row 3, when there is a distance to show (truths, or any target estimate): the true
     robot–target distance (black), the follower's own estimate from its pose and ``target_xy``
-    (blue) and the following band of ``params`` shaded green. Dashed red lines mark each loss,
+    (blue) and the following band shaded green (``params.band``, else the band ``metrics`` were
+    measured with). Dashed red lines mark each loss,
     green lines each re-acquisition. The title summarises ``metrics`` (computed when not given).
     """
-    params = params or MetricParams()
+    if params is None:
+        params = MetricParams(band=metrics.band) if metrics is not None else MetricParams()
     metrics = metrics or follow_metrics(log, params)
     a = episode_arrays(log, params)
     show_distance = a.has_truth or bool(np.isfinite(a.estimated_distance).any())

@@ -123,6 +123,7 @@ def test_following_rate_counts_band_from_first_identification() -> None:
     assert m.following_rate == pytest.approx(4 / 8)
     narrow = follow_metrics(make_log("LLVVVVVVVV", distance=dist), MetricParams(band=(0.9, 1.1)))
     assert narrow.following_rate == pytest.approx(2 / 8)
+    assert narrow.band == (0.9, 1.1) and narrow.to_json()["band"] == [0.9, 1.1]
 
 
 def test_wrong_and_lost_ticks_are_not_following() -> None:

@@ -11,7 +11,7 @@ from pfctl.core.episode import (
     TickRecord,
     WaypointRecord,
 )
-from pfctl.core.episode_metrics import follow_metrics, search_metrics
+from pfctl.core.episode_metrics import MetricParams, follow_metrics, search_metrics
 from pfctl.core.house import HouseLayout
 from pfctl.core.robot import GroundTruth, PersonTruth, Pose2D
 from pfctl.follow_plots import search_figure, timeline_figure, trajectory_figure
@@ -212,6 +212,14 @@ def test_timeline_figure() -> None:
         assert expected in labels
     assert fig.axes[-1].get_xlabel() == "time [s]"
     _assert_png(fig)
+
+
+def test_timeline_band_follows_the_metrics() -> None:
+    log = demo_log()
+    fig = timeline_figure(log, follow_metrics(log, MetricParams(band=(0.8, 1.9))))
+    (band,) = [p for p in fig.axes[2].patches if p.get_label() == "following band"]
+    ys = band.get_patch_transform().transform(band.get_path().vertices)[:, 1]
+    assert min(ys) == pytest.approx(0.8) and max(ys) == pytest.approx(1.9)
 
 
 def test_timeline_figure_without_truth_or_target() -> None:

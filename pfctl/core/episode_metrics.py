@@ -136,6 +136,8 @@ class FollowMetrics:
     """The start ``t`` of every identity switch (``len == identity_switches``)."""
     ground_truth: bool = True
     """False when the log had no truths and the robot's belief stood in (module docstring)."""
+    band: tuple[float, float] = MetricParams.band
+    """The following band the rate was measured with (:attr:`MetricParams.band`), m."""
 
     @property
     def median_time_to_refind_s(self) -> float | None:
@@ -165,6 +167,7 @@ class FollowMetrics:
             "distance_m": float(self.distance_m),
             "duration_s": float(self.duration_s),
             "ground_truth": bool(self.ground_truth),
+            "band": [float(self.band[0]), float(self.band[1])],
         }
 
 
@@ -368,6 +371,7 @@ def follow_metrics(log: EpisodeLog, params: MetricParams | None = None) -> Follo
             duration_s=duration,
             switch_times=switch_times,
             ground_truth=a.has_truth,
+            band=params.band,
         )
     first = int(correct_idx[0])
     distance_used = a.true_distance if a.has_truth else a.estimated_distance
@@ -406,6 +410,7 @@ def follow_metrics(log: EpisodeLog, params: MetricParams | None = None) -> Follo
         loss_times=tuple(float(x) for x in a.t[starts]),
         switch_times=switch_times,
         ground_truth=a.has_truth,
+        band=params.band,
     )
 
 
