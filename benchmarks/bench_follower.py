@@ -1,0 +1,458 @@
+"""Speed of one follower tick on one CPU core, in the crowd mission (or any mission).
+
+Run::
+
+    .venv/bin/python benchmarks/bench_follower.py                       # missions/house_crowd.yaml
+    .venv/bin/python benchmarks/bench_follower.py missions/house.yaml --duration 60
+    .venv/bin/python benchmarks/bench_follower.py --profile             # + cProfile of the ticks
+
+It learns the target in the simulator (not timed), then runs the follower
+(:func:`pfctl.commands.follow.run_sim_episode`) for ``--duration`` simulated seconds (default
+60) at the mission's tick rate and reports the median, 90th and 99th percentile and maximum wall
+time of one follower tick (:attr:`EpisodeResult.tick_seconds`: observe → perceive → map → behavior
+tree → act → log; the simulator's step, camera rendering included, is not in it). Goal: p99 under
+20 ms. The ticks are also split by what the observation carried (an RGB-D frame or not, read by
+a thin proxy around the robot's ``observe``), and each tick's time is broken into stages by
+timing a few methods in this process only (laser perception, leg detection, camera perception,
+person detection, Algorithm 2 identification, face detection and embedding with dlib, tracking,
+belief update, occupancy grid update, behavior tree, Algorithm 1, prediction, gaze, calls into the
+robot, Python's garbage collector): per stage how many ticks ran it, its median and p99 when it
+ran, and its mean share of the slowest 1 % of ticks. The ten slowest ticks are listed with what
+they did.
+
+``--profile`` then runs the same episode again (same seed) with :mod:`cProfile` enabled only
+inside ``Follower.tick`` and prints the ``--top`` (default 25) functions by cumulative time; the
+profiler slows every call down, so the percentiles above come from the un-profiled run.
+
+Like ``bench_perception.py`` it pins itself to CPU 0 and sets one BLAS/OpenMP thread before
+numpy is imported, and prints the machine. It prints figures; it asserts nothing about time.
+"""
+
+from __future__ import annotations
+
+import os
+
+# One core, one thread: set before numpy is imported.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+if hasattr(os, "sched_setaffinity"):
+    os.sched_setaffinity(0, {0})
+
+import argparse  # noqa: E402
+import cProfile  # noqa: E402
+import functools  # noqa: E402
+import gc  # noqa: E402
+import importlib  # noqa: E402
+import io  # noqa: E402
+import platform  # noqa: E402
+import pstats  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+from collections.abc import Callable, Iterator  # noqa: E402
+from contextlib import contextmanager  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import TYPE_CHECKING, Any, cast  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+if TYPE_CHECKING:
+    from pfctl.backends.pybullet.simulation import SimRobot
+    from pfctl.core.robot import Observation
+    from pfctl.follow_session import EpisodeResult
+    from pfctl.mission import Mission
+
+ROOT = Path(__file__).resolve().parents[1]
+CROWD = ROOT / "missions" / "house_crowd.yaml"
+GOAL_MS = 20.0
+
+#: The timed stages: (label, module, class or None for a module function, attribute).
+#: Indented labels run inside the stage above them; the unindented ones do not overlap.
+STAGES: tuple[tuple[str, str, str | None, str], ...] = (
+    ("laser perception (on_scan)", "pfctl.core.perception", "Perception", "on_scan"),
+    ("  leg detection", "pfctl.core.legs", "LegDetector", "detect"),
+    ("camera perception (on_frame)", "pfctl.core.perception", "Perception", "on_frame"),
+    ("  person detection (mask)", "pfctl.core.vision", "MaskPersonDetector", "detect"),
+    ("  identification (Alg. 2)", "pfctl.core.identity", "TargetIdentifier", "observe"),
+    ("    faces: dlib detect+embed", "pfctl.core.faces", "FaceEncoder", "detect"),
+    ("  belief update (Eq. 4)", "pfctl.core.belief", "HumanBelief", "update"),
+    ("tracking (in on_scan/on_frame)", "pfctl.core.tracking", "MultiPersonTracker", "update"),
+    ("occupancy grid (Eq. 1)", "pfctl.core.grid", "OccupancyGrid", "update_scan"),
+    ("behavior tree (tick_once)", "py_trees.behaviour", "Behaviour", "tick_once"),
+    ("  Algorithm 1 (next_waypoint)", "pfctl.core.behavior.skills", "Skills", "next_waypoint"),
+    ("  grid planner (plan)", "pfctl.core.planning", "GridPlanner", "plan"),
+    ("  robot calls (sim navigate, …)", "", None, ""),
+    ("prediction (SVR, on loss)", "pfctl.core.follower", "Follower", "_predict"),
+    ("gaze", "pfctl.core.follower", "Follower", "_gaze"),
+)
+#: The robot's navigate/command/nav_status/cancel, called from the leaves: the simulator plans
+#: a path inside ``navigate`` (a real robot's move_base plans on its own).
+ROBOT_STAGE = "  robot calls (sim navigate, …)"
+OBSERVE_STAGE = "observe (sim)"
+GC_STAGE = "garbage collector (within the above)"
+#: The stages that do not overlap; the tick minus their sum is "other".
+TOP_LEVEL = (
+    OBSERVE_STAGE,
+    "laser perception (on_scan)",
+    "camera perception (on_frame)",
+    "occupancy grid (Eq. 1)",
+    "behavior tree (tick_once)",
+    "prediction (SVR, on loss)",
+    "gaze",
+)
+
+
+class TickClock:
+    """Per-tick stage times: wrappers add into :attr:`current` while a tick runs."""
+
+    def __init__(self) -> None:
+        self.in_tick = False
+        self.current: dict[str, float] = {}
+        self.ticks: list[dict[str, float]] = []
+        self.frames: list[bool] = []
+        """Per tick: did the observation carry an RGB-D frame."""
+        self.scans: list[bool] = []
+        self.embedded = 0
+        """Faces embedded (dlib ResNet descriptors computed) in the running tick."""
+        self.embeddings: list[int] = []
+        self._gc_start: float | None = None
+        self.missing: list[str] = []
+
+    def add(self, stage: str, seconds: float) -> None:
+        if self.in_tick:
+            self.current[stage] = self.current.get(stage, 0.0) + seconds
+
+    def gc_callback(self, phase: str, info: dict[str, Any]) -> None:
+        """``gc.callbacks`` hook: time the collections that happen inside a tick."""
+        if phase == "start":
+            self._gc_start = time.perf_counter()
+        elif self._gc_start is not None:
+            self.add(GC_STAGE, time.perf_counter() - self._gc_start)
+            self._gc_start = None
+
+
+def _timed(clock: TickClock, stage: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` adding its wall time to ``stage`` (re-entrant calls counted once)."""
+    depth = 0
+
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kwargs: Any) -> Any:
+        nonlocal depth
+        if depth:
+            return fn(*args, **kwargs)
+        depth += 1
+        t0 = time.perf_counter()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            depth -= 1
+            clock.add(stage, time.perf_counter() - t0)
+
+    return wrapper
+
+
+@contextmanager
+def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> Iterator[None]:
+    """Wrap ``Follower.tick`` (and with ``clock`` the :data:`STAGES`) in this process; undo after.
+
+    Nothing on disk changes: the wrappers replace class attributes of the imported modules."""
+    from pfctl.core.follower import Follower
+
+    undo: list[tuple[Any, str, Any]] = []
+
+    def patch(owner: Any, name: str, value: Any) -> None:
+        undo.append((owner, name, owner.__dict__[name]))
+        setattr(owner, name, value)
+
+    tick = Follower.__dict__["tick"]
+
+    @functools.wraps(tick)
+    def timed_tick(self: Any) -> Any:
+        if clock is not None:
+            clock.current = {}
+            clock.embedded = 0
+            clock.in_tick = True
+        if profiler is not None:
+            profiler.enable()
+        try:
+            return tick(self)
+        finally:
+            if profiler is not None:
+                profiler.disable()
+            if clock is not None:
+                clock.in_tick = False
+                clock.ticks.append(clock.current)
+                clock.embeddings.append(clock.embedded)
+
+    patch(Follower, "tick", timed_tick)
+    if clock is not None:
+        for label, module, cls, attr in STAGES:
+            if not module:
+                continue
+            try:
+                owner = importlib.import_module(module)
+                owner = getattr(owner, cls) if cls else owner
+                fn = owner.__dict__[attr]
+            except (ImportError, AttributeError, KeyError):
+                clock.missing.append(label.strip())
+                continue
+            patch(owner, attr, _timed(clock, label, fn))
+        _count_embeddings(clock, patch)
+        gc.callbacks.append(clock.gc_callback)
+    try:
+        yield
+    finally:
+        if clock is not None:
+            gc.callbacks.remove(clock.gc_callback)
+        for owner, name, value in reversed(undo):
+            setattr(owner, name, value)
+
+
+def _count_embeddings(clock: TickClock, patch: Callable[[Any, str, Any], None]) -> None:
+    """Count the faces ``FaceEncoder.detect`` returns: each one was embedded."""
+    try:
+        from pfctl.core.faces import FaceEncoder
+    except ImportError:
+        return
+    detect = FaceEncoder.__dict__["detect"]
+
+    @functools.wraps(detect)
+    def counted(self: Any, *args: Any, **kwargs: Any) -> Any:
+        faces = detect(self, *args, **kwargs)
+        clock.embedded += len(faces)
+        return faces
+
+    patch(FaceEncoder, "detect", counted)
+
+
+class ProbedRobot:
+    """The simulated robot seen by the follower: notes what each observation carries and times
+    the calls the follower makes into the robot (they are the simulator's cost, not the
+    follower's); everything else goes straight to the robot."""
+
+    _TIMED = ("command", "navigate", "nav_status", "cancel")
+
+    def __init__(self, robot: SimRobot, clock: TickClock | None) -> None:
+        self._robot = robot
+        self._clock = clock
+
+    def observe(self) -> Observation:
+        t0 = time.perf_counter()
+        observation = self._robot.observe()
+        if self._clock is not None:
+            self._clock.add(OBSERVE_STAGE, time.perf_counter() - t0)
+            self._clock.frames.append(observation.rgbd is not None)
+            self._clock.scans.append(observation.scan is not None)
+        return observation
+
+    def __getattr__(self, name: str) -> Any:
+        value = getattr(self._robot, name)
+        if self._clock is None or name not in self._TIMED:
+            return value
+        return _timed(self._clock, ROBOT_STAGE, value)
+
+
+def run_once(
+    mission: Mission,
+    source: str,
+    seed: int | None,
+    duration: float,
+    clock: TickClock | None,
+    profiler: cProfile.Profile | None,
+) -> tuple[EpisodeResult, int]:
+    """Learn the target, then one instrumented episode; the result and the seed used."""
+    from rich.console import Console
+
+    from pfctl.commands.follow import _profile, _sim_robot, run_sim_episode
+
+    profile = _profile(mission, None, seed, Console(stderr=True), source)
+    robot = _sim_robot(mission, seed, False, source)
+    with robot, instrumented(clock, profiler):
+        port = cast("SimRobot", ProbedRobot(robot, clock))
+        result = run_sim_episode(mission, port, profile, duration)
+    return result, robot.seed
+
+
+def _pcts(ms: np.ndarray) -> str:
+    if len(ms) == 0:
+        return "no ticks"
+    return (
+        f"median {np.median(ms):6.2f}  p90 {np.percentile(ms, 90):6.2f}  "
+        f"p99 {np.percentile(ms, 99):6.2f}  max {ms.max():7.2f} ms  (n={len(ms)})"
+    )
+
+
+def cpu_name() -> str:
+    """The CPU's model name (from /proc/cpuinfo when there is one)."""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown"
+
+
+def _versions() -> str:
+    """Python and the versions of the libraries the tick leans on."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    parts = [f"python {platform.python_version()}"]
+    for dist in ("numpy", "scipy", "scikit-learn", "pybullet", "dlib", "py_trees"):
+        try:
+            parts.append(f"{dist} {version(dist)}")
+        except PackageNotFoundError:
+            continue
+    try:
+        import dlib
+
+        parts.append(f"(dlib BLAS {dlib.DLIB_USE_BLAS}, AVX {dlib.USE_AVX_INSTRUCTIONS})")
+    except ImportError:
+        pass
+    return ", ".join(parts)
+
+
+def report(result: EpisodeResult, clock: TickClock, mission: Mission, seed: int) -> None:
+    """Print the percentiles, the split by camera frame, the stages and the slowest ticks."""
+    ms = 1000.0 * np.asarray(result.tick_seconds, dtype=float)
+    n = len(ms)
+    frames = np.array(clock.frames[:n], dtype=bool)
+    scans = np.array(clock.scans[:n], dtype=bool)
+    ok = len(frames) == n and len(clock.ticks) == n and len(clock.embeddings) == n
+    p99 = float(np.percentile(ms, 99)) if n else float("nan")
+    verdict = "meets" if p99 < GOAL_MS else "misses"
+    print(
+        f"\nfollower tick, {mission.name}, seed {seed}: {result.sim_time:.1f} s simulated at "
+        f"{mission.behavior.tick_hz:g} Hz in {result.wall_time:.1f} s wall"
+    )
+    print(f"  all ticks        {_pcts(ms)}   → p99 {verdict} the goal < {GOAL_MS:g} ms")
+    if not ok:
+        print("  (the per-tick probes do not line up with the ticks; no breakdown)")
+        return
+    print(f"  with RGB-D frame {_pcts(ms[frames])}")
+    print(f"  without frame    {_pcts(ms[~frames])}")
+    print(f"  no scan either   {_pcts(ms[~frames & ~scans])}")
+    embedded = np.array(clock.embeddings) > 0
+    print(f"  with a face embedding    {_pcts(ms[embedded])}")
+    print(f"  without a face embedding {_pcts(ms[~embedded])}")
+    print(
+        f"  first tick {ms[0]:.1f} ms; p99 without the first second "
+        f"{_first_second_p99(ms, mission)}"
+    )
+
+    stage_ms = {
+        label: 1000.0 * np.array([t.get(label, np.nan) for t in clock.ticks])
+        for label in [OBSERVE_STAGE, *(s[0] for s in STAGES), GC_STAGE]
+    }
+    top = np.sum([np.nan_to_num(stage_ms[k]) for k in TOP_LEVEL], axis=0)
+    stage_ms["other (log, blackboard, …)"] = ms - top
+    slow = ms >= np.percentile(ms, 99)
+    print(
+        f"\n  stages (ms; 'ran' = ticks that called it; tail = mean over the {slow.sum()} "
+        f"slowest ticks, ≥ p99, whose mean is {ms[slow].mean():.1f} ms)"
+    )
+    print(f"  {'stage':34s} {'ran':>5s} {'median':>8s} {'p99':>8s} {'max':>8s} {'tail':>8s}")
+    for label, values in stage_ms.items():
+        ran = ~np.isnan(values)
+        if not ran.any():
+            print(f"  {label:34s} {0:5d}")
+            continue
+        v = values[ran]
+        tail = float(np.nan_to_num(values[slow]).mean())
+        print(
+            f"  {label:34s} {ran.sum():5d} {np.median(v):8.2f} {np.percentile(v, 99):8.2f} "
+            f"{v.max():8.2f} {tail:8.2f}"
+        )
+    if clock.missing:
+        print(f"  (not timed, not found in this code: {', '.join(clock.missing)})")
+
+    print("\n  the 10 slowest ticks")
+    records = result.log.ticks
+    for i in np.argsort(ms)[::-1][:10]:
+        parts = sorted(((v, k.strip()) for k, v in clock.ticks[i].items()), reverse=True)[:3]
+        rec = records[i] if i < len(records) else None
+        what = f"{rec.awareness}/{rec.action}" if rec is not None else "?"
+        print(
+            f"  t={rec.t if rec else float('nan'):6.1f} s {ms[i]:7.1f} ms "
+            f"{'frame' if frames[i] else '     '} {what:34s} "
+            + ", ".join(f"{k} {1000 * v:.1f}" for v, k in parts)
+        )
+
+
+def _first_second_p99(ms: np.ndarray, mission: Mission) -> str:
+    skip = round(mission.behavior.tick_hz)
+    return f"{np.percentile(ms[skip:], 99):.2f} ms" if len(ms) > skip else "—"
+
+
+def print_profile(profiler: cProfile.Profile, result: EpisodeResult, top: int) -> None:
+    """The ``top`` functions by cumulative time inside ``Follower.tick``."""
+    out = io.StringIO()
+    stats = pstats.Stats(profiler, stream=out)
+    total = sum(result.tick_seconds)
+    print(
+        f"\ncProfile inside Follower.tick ({len(result.tick_seconds)} ticks, {total:.1f} s of "
+        f"profiled tick time, profiler overhead included), top {top} by cumulative time:"
+    )
+    stats.strip_dirs().sort_stats("cumulative").print_stats(top)
+    text = out.getvalue()
+    start = text.find("   ncalls")
+    print(text[start:] if start >= 0 else text)
+
+
+def main() -> int:
+    """Parse the arguments, run, print; the exit status."""
+    parser = argparse.ArgumentParser(
+        description=__doc__.splitlines()[0], formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument(
+        "mission", nargs="?", type=Path, default=CROWD, help="mission YAML (default: house_crowd)"
+    )
+    parser.add_argument("--duration", type=float, default=60.0, help="simulated seconds")
+    parser.add_argument("--seed", type=int, default=None, help="seed (default: the scenario's)")
+    parser.add_argument("--profile", action="store_true", help="also cProfile the ticks")
+    parser.add_argument("--top", type=int, default=25, help="functions shown by --profile")
+    args = parser.parse_args()
+
+    if not args.mission.is_file():
+        hint = (
+            " (the crowd mission is not written yet; pass another, e.g. missions/house.yaml)"
+            if args.mission == CROWD
+            else ""
+        )
+        print(f"{args.mission}: no such mission file{hint}", file=sys.stderr)
+        return 2
+    from pfctl.errors import UserError
+    from pfctl.mission import load_mission
+
+    try:
+        mission = load_mission(args.mission)
+    except UserError as err:
+        print(err, file=sys.stderr)
+        return 2
+
+    affinity = sorted(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else "?"
+    print("pfctl follower-tick benchmark")
+    print(f"  machine : {platform.platform()} | {cpu_name()} | cpu affinity {affinity}")
+    print(f"  {_versions()}")
+    print(
+        f"  mission : {args.mission} ({len(mission.scenario.people)} people), "
+        f"{args.duration:g} s simulated, tick {mission.behavior.tick_hz:g} Hz"
+    )
+
+    clock = TickClock()
+    try:
+        result, seed = run_once(mission, str(args.mission), args.seed, args.duration, clock, None)
+    except UserError as err:
+        print(err, file=sys.stderr)
+        return 2
+    report(result, clock, mission, seed)
+
+    if args.profile:
+        profiler = cProfile.Profile()
+        result, _ = run_once(mission, str(args.mission), seed, args.duration, None, profiler)
+        print_profile(profiler, result, args.top)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
