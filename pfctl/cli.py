@@ -7,6 +7,8 @@ import sys
 import typer
 
 from pfctl import __version__
+from pfctl.commands import bt as bt_commands
+from pfctl.commands import follow as follow_commands
 from pfctl.commands import learn_target as learn_target_command
 from pfctl.commands import legs as legs_commands
 from pfctl.commands import map as map_commands
@@ -30,7 +32,10 @@ app.add_typer(map_commands.app, name="map")
 app.add_typer(sim_commands.app, name="sim")
 app.add_typer(predict_commands.app, name="predict")
 app.add_typer(legs_commands.app, name="legs")
+app.add_typer(bt_commands.app, name="bt")
 app.command("learn-target")(learn_target_command.learn_target)
+app.command("follow")(follow_commands.follow)
+app.command("search")(follow_commands.search)
 app.command("replay")(replay_command.replay)
 
 

@@ -19,8 +19,8 @@ from PIL import Image
 from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
+from pfctl.bt_render import ascii_tree, btcpp_xml, dot_tree, png_tree
 from pfctl.core.behavior.registry import LEAF_SPECS
-from pfctl.core.behavior.render import ascii_tree, btcpp_xml, dot_tree, png_tree
 from pfctl.core.behavior.tree import SimTimeout, build_tree, parse_layout
 from pfctl.mission import _paper_tree, load_mission
 

@@ -19,8 +19,8 @@ from typing import Annotated
 
 import typer
 
+from pfctl.bt_render import ascii_tree, btcpp_xml, dot_tree, png_tree
 from pfctl.core.behavior.registry import LEAF_SPECS, ParamSpec
-from pfctl.core.behavior.render import ascii_tree, btcpp_xml, dot_tree, png_tree
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import load_mission

@@ -1,0 +1,396 @@
+"""`pfctl follow` and `pfctl search`: the whole architecture on a robot (§III-B).
+
+``pfctl follow MISSION --backend sim``: learn the target (unless ``--target PROFILE``), then run
+the follower (:mod:`pfctl.core.follower`) in the simulated house for ``--duration`` simulated
+seconds: it follows the target, loses them, predicts, goes and looks, searches by Algorithm 1,
+re-identifies them and follows again, as the mission's behavior tree decides. Prints a summary
+(following rate, losses, each re-acquisition and how, identity switches, collisions, distance)
+and writes ``trajectory.png`` (Fig. 4), ``timeline.png`` (Fig. 6) and ``metrics.json`` into
+``--out``.
+
+``pfctl search MISSION --backend sim``: the target stands somewhere in the house out of view
+(``--region``, else a region away from the robot chosen by the seed); the robot searches until
+it identifies them or ``--duration`` runs out; prints the time to find and the path length,
+writes ``search.png`` and ``metrics.json``.
+
+Both stop the base on every exit; the first Ctrl-C ends the episode and keeps what was measured.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any
+
+import numpy as np
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+from rich.table import Table
+
+from pfctl.core.atomic_files import atomic_write_all
+from pfctl.core.episode import EpisodeLog, TickRecord
+from pfctl.core.episode_metrics import (
+    FollowMetrics,
+    MetricParams,
+    SearchMetrics,
+    follow_metrics,
+    search_metrics,
+)
+from pfctl.core.grid import FREE
+from pfctl.core.identity import TargetProfile, learn_profile
+from pfctl.core.robot import Observation, Robot
+from pfctl.errors import UserError
+from pfctl.follow_session import EpisodeResult, build_follower, run_follower
+from pfctl.mission import Mission, load_mission
+from pfctl.perception_setup import build_perception, identity_params
+
+if TYPE_CHECKING:
+    from pfctl.backends.pybullet.recording import EpisodeRecorder
+    from pfctl.backends.pybullet.simulation import SimRobot
+
+BACKENDS = ("sim",)
+#: Simulated seconds the robot watches the target posing when it learns them first.
+LEARN_SECONDS = 6.0
+
+
+def _check_common(backend: str, duration: float, out: Path) -> None:
+    if backend not in BACKENDS:
+        raise UserError(
+            f"--backend {backend}: expected one of {', '.join(BACKENDS)} "
+            "(the HSR backend is issue 7)"
+        )
+    if not (math.isfinite(duration) and duration > 0):
+        raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: exists and is not a directory")
+
+
+def _profile(
+    mission: Mission, path: Path | None, seed: int | None, console: Console, source: str
+) -> TargetProfile:
+    """The target's profile: read from ``path``, else learned in the simulator first."""
+    params = identity_params(mission)
+    if path is not None:
+        try:
+            profile = TargetProfile.load(path)
+            profile.check_params(params, str(path))
+        except (OSError, ValueError) as err:
+            raise UserError(f"--target {path}: {err}") from None
+        return profile
+    from pfctl.commands.learn_target import learn_in_sim
+
+    with Progress(
+        TextColumn("learning the target"),
+        BarColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    ) as progress:
+        learned = learn_in_sim(mission, LEARN_SECONDS, seed, params, progress, source)
+    try:
+        return learn_profile(learned.appearances, params)
+    except ValueError:
+        raise UserError(f"{source}: the simulated target was never seen whole") from None
+
+
+def _sim_robot(mission: Mission, seed: int | None, gui: bool, source: str) -> SimRobot:
+    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.core.planning import NoPathError
+
+    try:
+        return SimRobot(mission, SimOptions(seed=seed, gui=gui, realtime=gui))
+    except NoPathError as err:
+        raise UserError(f"{source}: scenario.people: a route cannot be walked: {err}") from None
+
+
+class RecordingRobot:
+    """The simulated robot, every observation the follower takes recorded with the truth."""
+
+    def __init__(self, robot: SimRobot, recorder: EpisodeRecorder) -> None:
+        self._robot = robot
+        self._recorder = recorder
+
+    def observe(self) -> Observation:
+        observation = self._robot.observe()
+        self._recorder.add(observation, self._robot.ground_truth())
+        return observation
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._robot, name)
+
+
+def run_sim_episode(
+    mission: Mission,
+    robot: SimRobot,
+    profile: TargetProfile,
+    duration: float,
+    *,
+    on_tick: Callable[[float], None] | None = None,
+    stop: Callable[[], bool] | None = None,
+    until_found: bool = False,
+    recorder: EpisodeRecorder | None = None,
+) -> EpisodeResult:
+    """The follower on the simulated robot for ``duration`` s, the truth recorded beside each
+    tick; ``until_found`` ends the run when the target is identified (``pfctl search``);
+    ``recorder`` also writes every observation to an episode bag."""
+    from pfctl.core.vision import MaskPersonDetector
+
+    detector = MaskPersonDetector(
+        robot.person_instances(),
+        robot.people_bodies.parts(),
+        min_pixels=mission.perception.vision.min_pixels,
+    )
+    perception = build_perception(
+        mission,
+        detector=detector,
+        profile=profile,
+        belief_grid=(robot.static_map.geometry, robot.static_map.states() != FREE),
+    )
+    log = EpisodeLog(target_name=mission.scenario.target)
+    port: Robot = robot if recorder is None else RecordingRobot(robot, recorder)  # type: ignore[assignment]
+    follower = build_follower(mission, port, perception, log)
+    params = _metric_params(mission)
+
+    def found(record: TickRecord) -> bool:
+        return record.target_id is not None and search_metrics(log, params).found
+
+    return run_follower(
+        follower,
+        robot,
+        duration,
+        now=lambda: robot.time,
+        truth=robot.ground_truth,
+        on_tick=on_tick,
+        stop=stop,
+        until=found if until_found else None,
+    )
+
+
+def _progress(console: Console, duration: float) -> Progress:
+    return Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        TextColumn("{task.completed:.1f}/{task.total:.0f} s simulated"),
+        TimeRemainingColumn(),
+        console=console,
+        transient=True,
+        disable=not console.is_terminal,
+    )
+
+
+def _write(out: Path, files: list[tuple[str, bytes | str]]) -> list[Path]:
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise UserError(f"--out {out}: cannot create it: {err.strerror or err}") from None
+    paths = [(out / name, data) for name, data in files]
+    try:
+        atomic_write_all(paths)
+    except OSError as err:
+        raise UserError(f"--out {out}: cannot write: {err.strerror or err}") from None
+    return [p for p, _ in paths]
+
+
+def _metric_params(mission: Mission) -> MetricParams:
+    lo, hi = mission.control.following_band
+    return MetricParams(band=(lo, hi))
+
+
+def follow(
+    mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
+    backend: Annotated[str, typer.Option("--backend", help="Where to run: sim.")] = "sim",
+    target: Annotated[
+        Path | None,
+        typer.Option("--target", help="A target profile (pfctl learn-target); default: learn."),
+    ] = None,
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+    ] = None,
+    duration: Annotated[float, typer.Option("--duration", help="Simulated seconds.")] = 120.0,
+    out: Annotated[
+        Path, typer.Option("--out", help="Folder for trajectory.png, timeline.png, metrics.json.")
+    ] = Path("out/follow"),
+    gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
+) -> None:
+    """Follow the mission's target; lose, predict, search, re-identify and follow again."""
+    from pfctl.backends.pybullet.runner import graceful_interrupts
+    from pfctl.follow_plots import timeline_figure, trajectory_figure
+    from pfctl.prediction_plots import png_bytes
+
+    _check_common(backend, duration, out)
+    loaded = load_mission(mission)
+    console = Console(stderr=True)
+    profile = _profile(loaded, target, seed, console, str(mission))
+    robot = _sim_robot(loaded, seed, gui, str(mission))
+    with robot, graceful_interrupts() as stop, _progress(console, duration) as bar:
+        task = bar.add_task("following", total=duration)
+        result = run_sim_episode(
+            loaded,
+            robot,
+            profile,
+            duration,
+            on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+            stop=stop,
+        )
+    metrics = follow_metrics(result.log, _metric_params(loaded))
+    title = f"{loaded.name}, seed {robot.seed}"
+    layout = loaded.layout()
+    files = [
+        ("metrics.json", json.dumps(_follow_json(metrics, result, robot.seed), indent=2) + "\n"),
+        ("trajectory.png", png_bytes(trajectory_figure(layout, result.log, metrics, title))),
+        ("timeline.png", png_bytes(timeline_figure(result.log, metrics))),
+    ]
+    written = _write(out, files)
+    _follow_report(metrics, result, written)
+    if result.interrupted:
+        raise typer.Exit(130)
+
+
+def _follow_json(metrics: FollowMetrics, result: EpisodeResult, seed: int) -> dict[str, object]:
+    data = metrics.to_json()
+    ticks = np.asarray(result.tick_seconds) * 1000.0
+    data.update(
+        seed=seed,
+        sim_time_s=round(result.sim_time, 3),
+        wall_time_s=round(result.wall_time, 3),
+        interrupted=result.interrupted,
+        tick_ms_median=round(float(np.median(ticks)), 3) if len(ticks) else None,
+        tick_ms_p99=round(float(np.percentile(ticks, 99)), 3) if len(ticks) else None,
+    )
+    return data
+
+
+def _follow_report(metrics: FollowMetrics, result: EpisodeResult, written: list[Path]) -> None:
+    out = Console(width=100, soft_wrap=True)
+    status = "interrupted after" if result.interrupted else "ran"
+    out.print(
+        f"{status} {result.sim_time:.1f} s simulated in {result.wall_time:.1f} s; "
+        f"first identified at "
+        + (
+            f"{metrics.first_identified_s:.1f} s"
+            if metrics.first_identified_s is not None
+            else "never"
+        )
+    )
+    table = Table(show_header=False, box=None)
+    table.add_row("following rate", f"{metrics.following_rate:.1%}")
+    table.add_row("losses", str(metrics.losses))
+    for r in metrics.reacquisitions:
+        table.add_row(
+            "  re-acquired",
+            f"lost at {r.t_lost:.1f} s, found at {r.t_found:.1f} s "
+            f"({r.t_found - r.t_lost:.1f} s) by {r.how}",
+        )
+    table.add_row("identity switches", str(metrics.identity_switches))
+    table.add_row("collisions", str(metrics.collisions))
+    table.add_row("distance driven", f"{metrics.distance_m:.1f} m")
+    out.print(table)
+    out.print("wrote " + ", ".join(str(p) for p in written))
+
+
+def search(
+    mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
+    backend: Annotated[str, typer.Option("--backend", help="Where to run: sim.")] = "sim",
+    target: Annotated[
+        Path | None,
+        typer.Option("--target", help="A target profile (pfctl learn-target); default: learn."),
+    ] = None,
+    region: Annotated[
+        str | None,
+        typer.Option("--region", help="Where the target hides (default: chosen by the seed)."),
+    ] = None,
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+    ] = None,
+    duration: Annotated[float, typer.Option("--duration", help="Give up after (s).")] = 180.0,
+    out: Annotated[
+        Path, typer.Option("--out", help="Folder for search.png and metrics.json.")
+    ] = Path("out/search"),
+    gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
+) -> None:
+    """Find the mission's target somewhere in the house: belief, Algorithm 1 and frontiers."""
+    from pfctl.backends.pybullet.runner import graceful_interrupts
+    from pfctl.follow_plots import search_figure
+    from pfctl.prediction_plots import png_bytes
+
+    _check_common(backend, duration, out)
+    loaded = load_mission(mission)
+    names = [r.name for r in loaded.map.regions]
+    if region is not None and region not in names:
+        raise UserError(f"--region {region}: unknown region (regions: {', '.join(names)})")
+    console = Console(stderr=True)
+    profile = _profile(loaded, target, seed, console, str(mission))
+    robot = _sim_robot(loaded, seed, gui, str(mission))
+    with robot:
+        hide_target(robot, region)
+        with graceful_interrupts() as stop, _progress(console, duration) as bar:
+            task = bar.add_task("searching", total=duration)
+            result = run_sim_episode(
+                loaded,
+                robot,
+                profile,
+                duration,
+                on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+                stop=stop,
+                until_found=True,
+            )
+    metrics = search_metrics(result.log, _metric_params(loaded))
+    data = metrics.to_json()
+    data.update(seed=robot.seed, region=robot_region(robot), sim_time_s=round(result.sim_time, 3))
+    files = [
+        ("metrics.json", json.dumps(data, indent=2) + "\n"),
+        ("search.png", png_bytes(search_figure(loaded.layout(), result.log, metrics))),
+    ]
+    written = _write(out, files)
+    _search_report(metrics, result, written)
+    if result.interrupted:
+        raise typer.Exit(130)
+
+
+def hide_target(robot: SimRobot, region: str | None) -> None:
+    """Put the scenario's target at a free spot of ``region`` (None: a region other than the
+    robot's, chosen by the seed), standing still, out of the robot's view."""
+    from pfctl.backends.pybullet.walkers import PERSON_RADIUS
+    from pfctl.core.regions import RegionMap
+
+    mission = robot.mission
+    target = next((w for w in robot.people if w.is_target), None)
+    if target is None:
+        raise UserError("scenario.target: the mission names no target to search for")
+    regions = RegionMap(mission.layout())
+    rng = np.random.default_rng([robot.seed, 99])
+    here = regions.locate((robot.pose.x, robot.pose.y))
+    choices = [n for n in regions.names if n != here and n not in regions.neighbours(here or "")]
+    if region is None:
+        choices = choices or [n for n in regions.names if n != here]
+        region = choices[int(rng.integers(len(choices)))]
+    planner = robot.planner.with_radius(PERSON_RADIUS + 0.2)
+    rows, cols = np.nonzero(planner.free)
+    cells = planner.geometry.cell_to_world(rows, cols)
+    inside = np.array([regions.locate(c) == region for c in cells[:: max(1, len(cells) // 4000)]])
+    cells = cells[:: max(1, len(cells) // 4000)][inside]
+    if len(cells) == 0:
+        raise UserError(f"--region {region}: no free spot for the target")
+    x, y = cells[int(rng.integers(len(cells)))]
+    target.hold(float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
+    robot.hidden_region = region  # type: ignore[attr-defined]
+
+
+def robot_region(robot: SimRobot) -> str | None:
+    return getattr(robot, "hidden_region", None)
+
+
+def _search_report(metrics: SearchMetrics, result: EpisodeResult, written: list[Path]) -> None:
+    out = Console(width=100, soft_wrap=True)
+    if metrics.found and metrics.time_to_find_s is not None:
+        out.print(f"found the target after {metrics.time_to_find_s:.1f} s")
+    else:
+        out.print(f"did not find the target in {result.sim_time:.1f} s")
+    out.print(f"  path length {metrics.distance_m:.1f} m, {metrics.collisions} collisions")
+    out.print("wrote " + ", ".join(str(p) for p in written))
+
+
+__all__ = ["follow", "hide_target", "run_sim_episode", "search"]

@@ -1,0 +1,102 @@
+"""The behavior tree's shared state: declared py_trees blackboard keys (§II-A).
+
+The follower (:mod:`pfctl.core.follower`) writes these keys once per tick, before the tree is
+ticked; leaves (:mod:`pfctl.core.behavior.leaves`) declare which of them they read or write. Each
+follower has its own namespace (:func:`new_namespace`), so two followers in one process (tests,
+campaigns) never share state; :func:`clear_namespace` drops one when its follower closes.
+"""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import numpy as np
+import py_trees
+
+from pfctl.core.robot import Pose2D
+
+#: The declared keys and what they hold.
+KEYS: dict[str, str] = {
+    "t": "time of this tick, s (simulated or ROS time)",
+    "pose": "Pose2D: the robot's believed pose in the map frame",
+    "target": "TargetState | None: the identified target's track, if the tracker still has it",
+    "last_seen": "Sighting | None: where and when the target was last detected, with its path",
+    "prediction": "PredictionState | None: where the lost target is predicted to have gone",
+    "skills": "Skills: how leaves drive the base and the head, navigate and search",
+}
+
+_counter = itertools.count(1)
+
+
+def new_namespace() -> str:
+    """A fresh namespace such as ``/follower_3`` for one follower's keys."""
+    return f"/follower_{next(_counter)}"
+
+
+def clear_namespace(namespace: str) -> None:
+    """Remove every key under ``namespace`` from the (process-wide) blackboard."""
+    prefix = namespace.rstrip("/") + "/"
+    for key in list(py_trees.blackboard.Blackboard.storage):
+        if key.startswith(prefix):
+            py_trees.blackboard.Blackboard.unset(key)
+
+
+@dataclass(frozen=True)
+class TargetState:
+    """The identified target's track this tick."""
+
+    track_id: int
+    x: float
+    y: float
+    vx: float
+    vy: float
+    last_detected: float
+    """Stamp of the track's last associated detection (laser legs or camera), s."""
+
+    @property
+    def xy(self) -> tuple[float, float]:
+        return (self.x, self.y)
+
+
+@dataclass(frozen=True, eq=False)
+class Sighting:
+    """The target's last detection: when, where, and its detected path before (``(k, 3)`` rows
+    ``t, x, y``) for prediction (§II-E) and Algorithm 1's heading region."""
+
+    t: float
+    xy: tuple[float, float]
+    history: np.ndarray = field(repr=False)
+
+
+@dataclass(eq=False)
+class PredictionState:
+    """A prediction made when the target was lost; leaves mark how far it has been used."""
+
+    made_at: float
+    last_seen: tuple[float, float]
+    path: np.ndarray = field(repr=False)
+    """``(k, 2)`` predicted positions (clipped to the map)."""
+    goal: tuple[float, float]
+    """Where to go and look: the clipped path's end, moved into free space for the robot."""
+    region: str | None = None
+    """The region the goal lies in."""
+    reached: bool = False
+    """The robot has arrived at the goal."""
+    used: bool = False
+    """The place has been looked at (or could not be reached): no longer available."""
+
+    @property
+    def available(self) -> bool:
+        return not self.used
+
+
+__all__ = [
+    "KEYS",
+    "Pose2D",
+    "PredictionState",
+    "Sighting",
+    "TargetState",
+    "clear_namespace",
+    "new_namespace",
+]

@@ -1,0 +1,361 @@
+"""The condition and action leaves of the behavior tree (§II-A, Fig. 2), on py_trees.
+
+Every leaf reads the follower's state from the blackboard keys of
+:mod:`pfctl.core.behavior.blackboard` (declared per leaf) and acts through the ``skills`` key
+(:class:`~pfctl.core.behavior.skills.Skills`). The statuses are honest: a condition is SUCCESS
+or FAILURE at once; an action is RUNNING while it works (a navigation in progress is running),
+SUCCESS when it has done its job, FAILURE when it cannot. An action that drives the base gives it
+up in ``terminate`` — also when a higher-priority branch preempts it (status INVALID).
+
+The names and parameters are those of :data:`pfctl.core.behavior.registry.LEAF_SPECS`;
+:func:`leaf_factory` makes the ``factory`` that :func:`pfctl.core.behavior.tree.build_tree`
+calls for each leaf of a mission's layout.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+import numpy as np
+import py_trees
+from py_trees.common import Access, Status
+
+from pfctl.core.behavior.blackboard import PredictionState, Sighting, TargetState
+from pfctl.core.behavior.registry import LEAF_SPECS
+from pfctl.core.behavior.skills import Skills
+from pfctl.core.control import sweep_pan
+from pfctl.core.regions import WaypointDecision
+
+
+class Leaf(py_trees.behaviour.Behaviour):
+    """A leaf with its resolved parameters and a blackboard client in the follower's namespace."""
+
+    reads: ClassVar[tuple[str, ...]] = ("t", "pose", "target", "last_seen", "prediction", "skills")
+    writes: ClassVar[tuple[str, ...]] = ()
+
+    def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
+        super().__init__(name)
+        self.params = params
+        self.bb = self.attach_blackboard_client(name=name, namespace=namespace)
+        for key in self.reads:
+            if key not in self.writes:
+                self.bb.register_key(key, access=Access.READ)
+        for key in self.writes:
+            self.bb.register_key(key, access=Access.WRITE)
+
+    # typed views of the keys
+    @property
+    def t(self) -> float:
+        return float(self.bb.t)
+
+    @property
+    def target(self) -> TargetState | None:
+        value: TargetState | None = self.bb.target
+        return value
+
+    @property
+    def last_seen(self) -> Sighting | None:
+        value: Sighting | None = self.bb.last_seen
+        return value
+
+    @property
+    def prediction(self) -> PredictionState | None:
+        value: PredictionState | None = self.bb.prediction
+        return value
+
+    @property
+    def skills(self) -> Skills:
+        value: Skills = self.bb.skills
+        return value
+
+    def visible(self, max_age: float = 0.5) -> bool:
+        target = self.target
+        return target is not None and self.t - target.last_detected <= max_age
+
+
+# -- conditions -----------------------------------------------------------------------------------
+
+
+class TargetVisible(Leaf):
+    """SUCCESS when the identified target's track was detected within ``max_age`` s."""
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.visible(self.params["max_age"]) else Status.FAILURE
+
+
+class TargetTracked(Leaf):
+    """SUCCESS while the tracker holds the identified target's track (detected or coasting)."""
+
+    def update(self) -> Status:
+        return Status.SUCCESS if self.target is not None else Status.FAILURE
+
+
+class TargetLostFor(Leaf):
+    """SUCCESS when the target has not been detected for ``seconds`` (or was never seen)."""
+
+    def update(self) -> Status:
+        target, seen = self.target, self.last_seen
+        last = target.last_detected if target is not None else (seen.t if seen else -math.inf)
+        return Status.SUCCESS if self.t - last >= self.params["seconds"] else Status.FAILURE
+
+
+class PredictionAvailable(Leaf):
+    """SUCCESS when a prediction of the lost target exists and has not been used up."""
+
+    def update(self) -> Status:
+        p = self.prediction
+        return Status.SUCCESS if p is not None and p.available else Status.FAILURE
+
+
+class NearTarget(Leaf):
+    """SUCCESS when the robot is within ``distance`` of the target (else of where it was last
+    seen)."""
+
+    def update(self) -> Status:
+        target, seen = self.target, self.last_seen
+        xy = target.xy if target is not None else (seen.xy if seen is not None else None)
+        if xy is None:
+            return Status.FAILURE
+        pose = self.bb.pose
+        near = math.hypot(xy[0] - pose.x, xy[1] - pose.y) <= self.params["distance"]
+        return Status.SUCCESS if near else Status.FAILURE
+
+
+# -- actions -----------------------------------------------------------------------------------
+
+
+class Action(Leaf):
+    """An action: it names itself to the skills while it runs and gives up the base at the end."""
+
+    def update(self) -> Status:
+        self.skills.claim(self.name)
+        return self.act()
+
+    def act(self) -> Status:
+        raise NotImplementedError
+
+    def terminate(self, new_status: Status) -> None:
+        if new_status in (Status.INVALID, Status.FAILURE):
+            self.skills.release()
+
+
+class FollowTarget(Action):
+    """Drive after the target (§II-E): TURN + GO_STRAIGHT, or MOVE_BASE when the line of sight
+    is blocked; keeps ``distance``. RUNNING while there is a target, FAILURE without one."""
+
+    def act(self) -> Status:
+        target = self.target
+        if target is None:
+            return Status.FAILURE
+        self.skills.follow(target.xy, self.params["distance"])
+        return Status.RUNNING
+
+
+class GazeAtTarget(Action):
+    """Point the head at the target; RUNNING while there is one, FAILURE without."""
+
+    def act(self) -> Status:
+        target = self.target
+        if target is None:
+            return Status.FAILURE
+        self.skills.look_at(target.xy, "target")
+        return Status.RUNNING
+
+    def terminate(self, new_status: Status) -> None:
+        """The head is the follower's again; the base was never this leaf's."""
+
+
+class GoToPrediction(Action):
+    """MOVE_BASE to where the prediction says the target went. SUCCESS on arrival (at once if
+    the robot already arrived there), FAILURE without a prediction or a way there (the
+    prediction is then used up)."""
+
+    def act(self) -> Status:
+        p = self.prediction
+        if p is None or p.used:
+            return Status.FAILURE
+        if p.reached:
+            return Status.SUCCESS
+        outcome = self.skills.go_to(p.goal, self.params["tolerance"])
+        if outcome == "arrived":
+            p.reached = True
+            return Status.SUCCESS
+        if outcome == "failed":
+            p.used = True
+            return Status.FAILURE
+        return Status.RUNNING
+
+
+class LookAround(Action):
+    """Sweep the head ±``pan`` over ``seconds`` and, with ``turn``, turn the base once around.
+    SUCCESS as soon as the target is detected; FAILURE when the sweep ends without it — the
+    prediction (if any) is then used up, so the tree moves on (Fig. 2: way-point search)."""
+
+    def initialise(self) -> None:
+        self._start = self.t
+
+    def act(self) -> Status:
+        if self.visible():
+            return Status.SUCCESS
+        elapsed = self.t - self._start
+        seconds = float(self.params["seconds"])
+        if elapsed >= seconds:
+            if self.prediction is not None:
+                self.prediction.used = True
+            self.skills.stop()
+            return Status.FAILURE
+        self.skills.set_pan(sweep_pan(elapsed, seconds, float(self.params["pan"])))
+        if self.params["turn"]:
+            wz = min(2.0 * math.pi / seconds, self.skills.control.max_angular_speed)
+            self.skills.turn(wz)
+        else:
+            self.skills.stop()
+        return Status.RUNNING
+
+
+class WaypointSearch(Action):
+    """**Algorithm 1** as an action: go to the way-point toward the heading region l* (the
+    target's last path decides l*), re-deciding every ``REPLAN_S`` seconds and on arrival as the
+    occupancy grid fills in; a way-point that cannot be reached is skipped. RUNNING until the
+    target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing left to search."""
+
+    REPLAN_S: ClassVar[float] = 3.0
+    #: Way-points closer than this to one given up are not chosen again, metres.
+    GIVE_UP_RADIUS: ClassVar[float] = 0.6
+
+    writes: ClassVar[tuple[str, ...]] = ()
+
+    def initialise(self) -> None:
+        self._decision: WaypointDecision | None = None
+        self._decided_at = -math.inf
+        self._given_up: list[tuple[float, float]] = []
+        self.decisions: list[tuple[float, WaypointDecision]] = []
+
+    def _decide(self) -> WaypointDecision:
+        seen = self.last_seen
+        history = seen.history if seen is not None else np.empty((0, 3))
+        decision = self.skills.next_waypoint(history)
+        self._decided_at = self.t
+        if any(math.dist(decision.waypoint, g) < self.GIVE_UP_RADIUS for g in self._given_up):
+            # pick the best cluster goal not given up, if any
+            order = np.argsort(-np.asarray(decision.utilities)) if decision.utilities else []
+            for i in order:
+                goal = decision.goals[int(i)]
+                if all(math.dist(goal, g) >= self.GIVE_UP_RADIUS for g in self._given_up):
+                    decision = _with_waypoint(decision, goal)
+                    break
+        self._decision = decision
+        self.decisions.append((self.t, decision))
+        self.skills.waypoint = decision
+        return decision
+
+    def act(self) -> Status:
+        if self.visible():
+            return Status.SUCCESS
+        decision = self._decision
+        if decision is None or self.t - self._decided_at >= self.REPLAN_S:
+            decision = self._decide()
+        if decision.reason == "no_target":
+            return Status.FAILURE
+        outcome = self.skills.go_to(decision.waypoint, self.params["tolerance"])
+        if outcome == "running":
+            return Status.RUNNING
+        if outcome == "failed":
+            self._given_up.append(decision.waypoint)
+        decision = self._decide()
+        if decision.reason == "no_target":
+            return Status.FAILURE
+        if any(math.dist(decision.waypoint, g) < self.GIVE_UP_RADIUS for g in self._given_up):
+            return Status.FAILURE
+        if (
+            math.dist(decision.waypoint, (self.bb.pose.x, self.bb.pose.y))
+            <= self.params["tolerance"]
+        ):
+            # nothing new to go to from here: turn to look while the grid fills in
+            self.skills.turn(self.skills.control.max_angular_speed * 0.5)
+            return Status.RUNNING
+        self.skills.go_to(decision.waypoint, self.params["tolerance"])
+        return Status.RUNNING
+
+
+def _with_waypoint(decision: WaypointDecision, goal: tuple[float, float]) -> WaypointDecision:
+    from dataclasses import replace
+
+    best = decision.goals.index(goal)
+    return replace(decision, waypoint=goal, best=best, reason="frontier")
+
+
+class GoToLastSeen(Action):
+    """MOVE_BASE to where the target was last detected; SUCCESS on arrival, FAILURE if never
+    seen or unreachable."""
+
+    def act(self) -> Status:
+        seen = self.last_seen
+        if seen is None:
+            return Status.FAILURE
+        outcome = self.skills.go_to(seen.xy, self.params["tolerance"])
+        if outcome == "arrived":
+            return Status.SUCCESS
+        return Status.FAILURE if outcome == "failed" else Status.RUNNING
+
+
+class Stop(Action):
+    """Stop the base; SUCCESS."""
+
+    def act(self) -> Status:
+        self.skills.stop()
+        return Status.SUCCESS
+
+
+LEAF_CLASSES: dict[str, type[Leaf]] = {
+    "target_visible": TargetVisible,
+    "target_tracked": TargetTracked,
+    "target_lost_for": TargetLostFor,
+    "prediction_available": PredictionAvailable,
+    "near_target": NearTarget,
+    "follow_target": FollowTarget,
+    "gaze_at_target": GazeAtTarget,
+    "go_to_prediction": GoToPrediction,
+    "look_around": LookAround,
+    "waypoint_search": WaypointSearch,
+    "go_to_last_seen": GoToLastSeen,
+    "stop": Stop,
+}
+assert set(LEAF_CLASSES) == set(LEAF_SPECS), "every registered leaf has a behaviour"
+
+#: Search actions: when one of them runs while the target is lost, the robot is "predicted"
+#: (going to the prediction and looking there) or "searching" (Algorithm 1).
+PREDICTION_ACTIONS = ("go_to_prediction", "look_around")
+SEARCH_ACTIONS = ("waypoint_search", "go_to_last_seen")
+
+
+def leaf_factory(
+    namespace: str, defaults: dict[str, dict[str, Any]] | None = None
+) -> Callable[[str, str, dict[str, Any]], py_trees.behaviour.Behaviour]:
+    """The ``factory(kind, name, params)`` of :func:`~pfctl.core.behavior.tree.build_tree`:
+    leaves in ``namespace``; ``defaults[name][param]`` fills parameters left None (the
+    mission's values, e.g. ``follow_target.distance``)."""
+
+    def make(kind: str, name: str, params: dict[str, Any]) -> py_trees.behaviour.Behaviour:
+        spec = LEAF_SPECS[name]
+        if spec.kind != kind:
+            raise ValueError(f"{name} is a {spec.kind}, not a {kind}")
+        filled = dict(params)
+        for key, value in (defaults or {}).get(name, {}).items():
+            if filled.get(key) is None:
+                filled[key] = value
+        return LEAF_CLASSES[name](name, namespace, filled)
+
+    return make
+
+
+__all__ = [
+    "LEAF_CLASSES",
+    "PREDICTION_ACTIONS",
+    "SEARCH_ACTIONS",
+    "Action",
+    "Leaf",
+    "leaf_factory",
+]
