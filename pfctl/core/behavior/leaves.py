@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any, ClassVar
 
 import numpy as np
@@ -217,37 +218,53 @@ class LookAround(Action):
 
 class WaypointSearch(Action):
     """**Algorithm 1** as an action: go to the way-point toward the heading region l* (the
-    target's last path decides l*), re-deciding every ``REPLAN_S`` seconds and on arrival as the
-    occupancy grid fills in; a way-point that cannot be reached is skipped. RUNNING until the
-    target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing left to search."""
+    target's last path decides l*), re-deciding every ``REPLAN_S`` seconds as the occupancy grid
+    fills in. The robot keeps its way-point while that frontier still exists (so it does not
+    dither between clusters), and a way-point it has reached or could not reach is not chosen
+    again; when every frontier left has been visited, it turns in place to look and starts
+    afresh. RUNNING until the target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing
+    at all to search (no region to go to)."""
 
     REPLAN_S: ClassVar[float] = 3.0
-    #: Way-points closer than this to one given up are not chosen again, metres.
-    GIVE_UP_RADIUS: ClassVar[float] = 0.6
-
-    writes: ClassVar[tuple[str, ...]] = ()
+    #: A frontier goal this close to a visited way-point counts as visited, metres.
+    VISITED_RADIUS: ClassVar[float] = 0.8
+    #: A new decision keeps the current way-point if a goal lies this close to it, metres.
+    KEEP_RADIUS: ClassVar[float] = 0.6
 
     def initialise(self) -> None:
         self._decision: WaypointDecision | None = None
         self._decided_at = -math.inf
-        self._given_up: list[tuple[float, float]] = []
-        self.decisions: list[tuple[float, WaypointDecision]] = []
+        self._visited: list[tuple[float, float]] = []
+
+    def _fresh(self, goal: tuple[float, float]) -> bool:
+        return all(math.dist(goal, v) >= self.VISITED_RADIUS for v in self._visited)
 
     def _decide(self) -> WaypointDecision:
         seen = self.last_seen
         history = seen.history if seen is not None else np.empty((0, 3))
         decision = self.skills.next_waypoint(history)
         self._decided_at = self.t
-        if any(math.dist(decision.waypoint, g) < self.GIVE_UP_RADIUS for g in self._given_up):
-            # pick the best cluster goal not given up, if any
-            order = np.argsort(-np.asarray(decision.utilities)) if decision.utilities else []
-            for i in order:
-                goal = decision.goals[int(i)]
-                if all(math.dist(goal, g) >= self.GIVE_UP_RADIUS for g in self._given_up):
-                    decision = _with_waypoint(decision, goal)
-                    break
+        current = self._decision
+        goals = [g for g in decision.goals if self._fresh(g)]
+        keep = None
+        if current is not None and current.reason == "frontier":
+            keep = next(
+                (g for g in goals if math.dist(g, current.waypoint) < self.KEEP_RADIUS), None
+            )
+        if keep is not None:
+            decision = _with_waypoint(decision, keep)
+        elif decision.reason == "frontier" and not self._fresh(decision.waypoint):
+            ranked = sorted(
+                (i for i, g in enumerate(decision.goals) if self._fresh(g)),
+                key=lambda i: -decision.utilities[i],
+            )
+            if ranked and np.isfinite(decision.utilities[ranked[0]]):
+                decision = _with_waypoint(decision, decision.goals[ranked[0]])
+            elif decision.target_point is not None:
+                decision = replace(
+                    decision, waypoint=decision.target_point, reason="visited_fallback", best=None
+                )
         self._decision = decision
-        self.decisions.append((self.t, decision))
         self.skills.waypoint = decision
         return decision
 
@@ -262,27 +279,18 @@ class WaypointSearch(Action):
         outcome = self.skills.go_to(decision.waypoint, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING
-        if outcome == "failed":
-            self._given_up.append(decision.waypoint)
+        self._visited.append(decision.waypoint)
+        if decision.reason == "visited_fallback":
+            self._visited.clear()  # everything was seen once: look here, then start afresh
         decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        if any(math.dist(decision.waypoint, g) < self.GIVE_UP_RADIUS for g in self._given_up):
-            return Status.FAILURE
-        if (
-            math.dist(decision.waypoint, (self.bb.pose.x, self.bb.pose.y))
-            <= self.params["tolerance"]
-        ):
-            # nothing new to go to from here: turn to look while the grid fills in
+        if self.skills.go_to(decision.waypoint, self.params["tolerance"]) != "running":
             self.skills.turn(self.skills.control.max_angular_speed * 0.5)
-            return Status.RUNNING
-        self.skills.go_to(decision.waypoint, self.params["tolerance"])
         return Status.RUNNING
 
 
 def _with_waypoint(decision: WaypointDecision, goal: tuple[float, float]) -> WaypointDecision:
-    from dataclasses import replace
-
     best = decision.goals.index(goal)
     return replace(decision, waypoint=goal, best=best, reason="frontier")
 
