@@ -52,6 +52,7 @@ import multiprocessing as mp  # noqa: E402
 import platform  # noqa: E402
 import signal  # noqa: E402
 import sys  # noqa: E402
+import threading  # noqa: E402
 import time  # noqa: E402
 import traceback  # noqa: E402
 from collections import deque  # noqa: E402
@@ -164,17 +165,33 @@ def error_row(task: Task, message: str) -> dict[str, Any]:
     return row
 
 
-def _worker(task: Task, conn: Connection) -> None:
+def _exit_with_parent(parent: int) -> None:
+    """End this worker at once if the campaign process that started it goes away."""
+
+    def watch() -> None:
+        while True:
+            time.sleep(2.0)
+            if os.getppid() != parent:
+                os._exit(3)
+
+    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
+
+
+def _worker(task: Task, conn: Connection, parent: int) -> None:
     """Process entry point: run ``task`` and send its row (an error row if it raised)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
+    _exit_with_parent(parent)
     try:
         row = run_episode(task)
     except BaseException as err:  # any failure becomes an error row
         last = traceback.extract_tb(err.__traceback__)[-1:] if err.__traceback__ else []
         where = f" ({Path(last[0].filename).name}:{last[0].lineno})" if last else ""
         row = error_row(task, f"{type(err).__name__}: {err}{where}".replace("\n", " "))
-    conn.send(row)
-    conn.close()
+    try:
+        conn.send(row)
+        conn.close()
+    except OSError:  # the campaign is gone: nobody to tell
+        pass
 
 
 # -- the scheduler --------------------------------------------------------------------------------
@@ -217,7 +234,7 @@ def run_campaign(
             while pending and len(running) < jobs:
                 task = pending.popleft()
                 recv, send = ctx.Pipe(duplex=False)
-                proc = ctx.Process(target=_worker, args=(task, send), daemon=True)
+                proc = ctx.Process(target=_worker, args=(task, send, os.getpid()), daemon=True)
                 proc.start()
                 send.close()  # the child holds the only write end: EOF when it dies
                 running.append(_Running(task, proc, recv, time.monotonic()))
@@ -425,6 +442,24 @@ def _progress_line(done: int, total: int, row: dict[str, Any]) -> str:
     )
 
 
+def _git_state() -> str | None:
+    """``git describe --always --dirty`` of the repository (the code the workers ran)."""
+    import subprocess
+
+    try:
+        out = subprocess.run(
+            ["git", "describe", "--always", "--dirty"],
+            cwd=ROOT,
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        )
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() or None
+
+
 def _labels(paths: list[str]) -> list[str]:
     """File stems, or the paths themselves when two stems collide."""
     stems = [Path(p).stem for p in paths]
@@ -523,6 +558,7 @@ def main(argv: list[str] | None = None) -> int:
             "wall_s": wall,
             "finished": len(rows),
             "planned": len(tasks),
+            "git": _git_state(),
         },
         "machine": {
             "platform": platform.platform(),
