@@ -7,8 +7,8 @@ Run::
     .venv/bin/python benchmarks/follow_campaign.py A.yaml B.yaml --seeds 10 --first-seed 101 \\
         --duration 120 --jobs 4 --out out/campaign-ab
 
-For every mission (default: ``missions/house.yaml``, ``missions/house_no_prediction.yaml`` and
-``missions/house_no_waypoint_search.yaml``, the paper's experiment and its two ablations) and
+For every mission (default: ``missions/paper_episode.yaml``, ``missions/house_no_prediction.yaml``
+and ``missions/house_no_waypoint_search.yaml``: the paper's episode and its two ablations) and
 every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), one worker process
 loads the mission, learns the target's profile in the simulator *with that seed* (the faces
 depend on the seed), runs the follower for ``--duration`` simulated seconds (default 120) with
@@ -65,7 +65,7 @@ import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_MISSIONS = (
-    "missions/house.yaml",
+    "missions/paper_episode.yaml",
     "missions/house_no_prediction.yaml",
     "missions/house_no_waypoint_search.yaml",
 )
@@ -460,6 +460,13 @@ def _git_state() -> str | None:
     return out.stdout.strip() or None
 
 
+def _sha1(path: str) -> str:
+    """The SHA-1 of a mission file, to tell which version a campaign ran."""
+    import hashlib
+
+    return hashlib.sha1(Path(path).read_bytes()).hexdigest()
+
+
 def _labels(paths: list[str]) -> list[str]:
     """File stems, or the paths themselves when two stems collide."""
     stems = [Path(p).stem for p in paths]
@@ -522,6 +529,8 @@ def main(argv: list[str] | None = None) -> int:
         flush=True,
     )
 
+    git = _git_state()  # the code the workers will import
+    digests = {label: _sha1(path) for label, path in zip(labels, paths, strict=True)}
     csv_path = args.out / "episodes.csv"
     started = time.perf_counter()
     with csv_path.open("w", newline="") as f:
@@ -558,7 +567,8 @@ def main(argv: list[str] | None = None) -> int:
             "wall_s": wall,
             "finished": len(rows),
             "planned": len(tasks),
-            "git": _git_state(),
+            "git": git,
+            "mission_sha1": digests,
         },
         "machine": {
             "platform": platform.platform(),
