@@ -325,7 +325,7 @@ def search(
     profile = _profile(loaded, target, seed, console, str(mission))
     robot = _sim_robot(loaded, seed, gui, str(mission))
     with robot:
-        hide_target(robot, region)
+        hidden_in = hide_target(robot, region)
         with graceful_interrupts() as stop, _progress(console, duration) as bar:
             task = bar.add_task("searching", total=duration)
             result = run_sim_episode(
@@ -339,7 +339,7 @@ def search(
             )
     metrics = search_metrics(result.log, _metric_params(loaded))
     data = metrics.to_json()
-    data.update(seed=robot.seed, region=robot_region(robot), sim_time_s=round(result.sim_time, 3))
+    data.update(seed=robot.seed, region=hidden_in, sim_time_s=round(result.sim_time, 3))
     files = [
         ("metrics.json", json.dumps(data, indent=2) + "\n"),
         ("search.png", png_bytes(search_figure(loaded.layout(), result.log, metrics))),
@@ -350,9 +350,9 @@ def search(
         raise typer.Exit(130)
 
 
-def hide_target(robot: SimRobot, region: str | None) -> None:
+def hide_target(robot: SimRobot, region: str | None) -> str:
     """Put the scenario's target at a free spot of ``region`` (None: a region other than the
-    robot's, chosen by the seed), standing still, out of the robot's view."""
+    robot's, chosen by the seed), standing still, out of the robot's view; the region used."""
     from pfctl.backends.pybullet.walkers import PERSON_RADIUS
     from pfctl.core.regions import RegionMap
 
@@ -376,11 +376,7 @@ def hide_target(robot: SimRobot, region: str | None) -> None:
         raise UserError(f"--region {region}: no free spot for the target")
     x, y = cells[int(rng.integers(len(cells)))]
     target.hold(float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
-    robot.hidden_region = region  # type: ignore[attr-defined]
-
-
-def robot_region(robot: SimRobot) -> str | None:
-    return getattr(robot, "hidden_region", None)
+    return region
 
 
 def _search_report(metrics: SearchMetrics, result: EpisodeResult, written: list[Path]) -> None:

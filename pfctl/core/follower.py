@@ -23,7 +23,6 @@ The follower never reads ground truth. :meth:`close` stops the base.
 
 from __future__ import annotations
 
-import math
 from collections import deque
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -282,10 +281,6 @@ class Follower:
         finally:
             self.robot.command(STOP)
             clear_namespace(self.namespace)
-
-
-def distance(a: tuple[float, float], b: tuple[float, float]) -> float:
-    return math.hypot(a[0] - b[0], a[1] - b[1])
 
 
 __all__ = ["Follower", "FollowerParams", "PredictionParams"]

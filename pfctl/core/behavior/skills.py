@@ -69,6 +69,8 @@ class Skills:
         self.robot = robot
         self.control = control
         self.base = BaseController(control)
+        self._controllers: dict[float, BaseController] = {}
+        """Controllers for leaves that ask for another following distance."""
         self.gaze = GazeController(control)
         self.planner = planner
         self.grid = grid
@@ -149,12 +151,11 @@ class Skills:
 
     def follow(self, target_xy: tuple[float, float], distance: float | None = None) -> str:
         """One step of following the target (§II-E base control); returns the mode."""
-        params = self.control
-        if distance is not None and distance != params.following_distance:
-            params = _with_distance(params, distance)
-            controller = BaseController(params)
-        else:
-            controller = self.base
+        controller = self.base
+        if distance is not None and distance != self.control.following_distance:
+            if distance not in self._controllers:
+                self._controllers[distance] = BaseController(_with_distance(self.control, distance))
+            controller = self._controllers[distance]
         blocked = self.grid.logodds >= _OCCUPIED_LOGODDS
         cmd = controller.follow(
             self.pose,
