@@ -213,6 +213,10 @@ def follow(
     out: Annotated[
         Path, typer.Option("--out", help="Folder for trajectory.png, timeline.png, metrics.json.")
     ] = Path("out/follow"),
+    record: Annotated[
+        Path | None,
+        typer.Option("--record", help="Also record the episode (ROS 1 bag + truth) into DIR."),
+    ] = None,
     gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
 ) -> None:
     """Follow the mission's target; lose, predict, search, re-identify and follow again."""
@@ -225,16 +229,26 @@ def follow(
     console = Console(stderr=True)
     profile = _profile(loaded, target, seed, console, str(mission))
     robot = _sim_robot(loaded, seed, gui, str(mission))
-    with robot, graceful_interrupts() as stop, _progress(console, duration) as bar:
-        task = bar.add_task("following", total=duration)
-        result = run_sim_episode(
-            loaded,
-            robot,
-            profile,
-            duration,
-            on_tick=lambda t: bar.update(task, completed=min(t, duration)),
-            stop=stop,
-        )
+    with robot:
+        recorder = _recorder(record, loaded)
+        try:
+            with graceful_interrupts() as stop, _progress(console, duration) as bar:
+                task = bar.add_task("following", total=duration)
+                result = run_sim_episode(
+                    loaded,
+                    robot,
+                    profile,
+                    duration,
+                    on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+                    stop=stop,
+                    recorder=recorder,
+                )
+            if recorder is not None:
+                recorder.close()
+        except BaseException:
+            if recorder is not None:
+                recorder.abort()
+            raise
     metrics = follow_metrics(result.log, _metric_params(loaded))
     title = f"{loaded.name}, seed {robot.seed}"
     layout = loaded.layout()
@@ -247,6 +261,20 @@ def follow(
     _follow_report(metrics, result, written)
     if result.interrupted:
         raise typer.Exit(130)
+
+
+def _recorder(record: Path | None, mission: Mission) -> EpisodeRecorder | None:
+    """An episode recorder into ``record`` (as ``pfctl sim run --record``), or None."""
+    if record is None:
+        return None
+    from pfctl.backends.pybullet.recording import EpisodeRecorder, RecordingError
+    from pfctl.commands.sim import _check_episode_dir
+
+    _check_episode_dir(record)
+    try:
+        return EpisodeRecorder(record, mission.name, images=False)
+    except RecordingError as err:
+        raise UserError(str(err)) from None
 
 
 def _follow_json(metrics: FollowMetrics, result: EpisodeResult, seed: int) -> dict[str, object]:
