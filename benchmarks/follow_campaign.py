@@ -7,7 +7,7 @@ Run::
     .venv/bin/python benchmarks/follow_campaign.py A.yaml B.yaml --seeds 10 --first-seed 101 \\
         --duration 120 --jobs 4 --out out/campaign-ab
 
-For every mission (default: ``missions/paper_episode.yaml``, ``missions/house_no_prediction.yaml``
+For every mission (default: ``missions/house.yaml``, ``missions/house_no_prediction.yaml``
 and ``missions/house_no_waypoint_search.yaml``: the paper's episode and its two ablations) and
 every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), one worker process
 loads the mission, learns the target's profile in the simulator *with that seed* (the faces
@@ -67,7 +67,7 @@ import numpy as np  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_MISSIONS = (
-    "missions/paper_episode.yaml",
+    "missions/house.yaml",
     "missions/house_no_prediction.yaml",
     "missions/house_no_waypoint_search.yaml",
 )
@@ -236,7 +236,9 @@ def run_campaign(
             while pending and len(running) < jobs:
                 task = pending.popleft()
                 recv, send = ctx.Pipe(duplex=False)
-                proc = ctx.Process(target=_worker, args=(task, send, os.getpid()), daemon=True)
+                # not daemonic: an episode starts its own face worker process (daemonic
+                # processes may not have children); _exit_with_parent and the kills below end it
+                proc = ctx.Process(target=_worker, args=(task, send, os.getpid()), daemon=False)
                 proc.start()
                 send.close()  # the child holds the only write end: EOF when it dies
                 running.append(_Running(task, proc, recv, time.monotonic()))

@@ -101,7 +101,7 @@ def test_shipped_mission_validates_with_five_regions_and_five_doors() -> None:
         "bedroom",
     ]
     assert len(layout.doors) == 5
-    assert len(layout.obstacles) == 5
+    assert len(layout.obstacles) == 6
     assert layout.doors[0].between == ("kitchen", "living_room")
     assert layout.doors[0].segment == ((5.0, 1.5), (5.0, 2.4))
     assert layout.region("kitchen").polygon == ((0.0, 0.0), (5.0, 0.0), (5.0, 4.0), (0.0, 4.0))
@@ -117,7 +117,7 @@ def test_validate_command_prints_ok_summary(
 ) -> None:
     code, out, err = run_cli(["mission", "validate", str(HOUSE)], capsys, monkeypatch)
     assert code == 0, err
-    assert out == f"OK {HOUSE}: 5 regions, 5 doors, 5 obstacles, tree of 10 nodes\n"
+    assert out == f"OK {HOUSE}: 5 regions, 5 doors, 6 obstacles, tree of 10 nodes\n"
     assert err == ""
 
 
@@ -529,7 +529,7 @@ def test_subprocess_validates_the_shipped_mission() -> None:
     result = run_subprocess(["mission", "validate", "missions/house.yaml"], cwd=ROOT)
     assert result.returncode == 0, result.stderr
     assert result.stdout == (
-        "OK missions/house.yaml: 5 regions, 5 doors, 5 obstacles, tree of 10 nodes\n"
+        "OK missions/house.yaml: 5 regions, 5 doors, 6 obstacles, tree of 10 nodes\n"
     )
 
 

@@ -1,4 +1,4 @@
-"""The paper's episode end to end (§III-B): ``pfctl follow missions/paper_episode.yaml --backend sim
+"""The paper's episode end to end (§III-B): ``pfctl follow missions/house.yaml --backend sim
 --seed 1`` — the robot learns Alice, follows her from the kitchen, loses her at the office door,
 goes to the SVR prediction and looks around, starts way-point search (Algorithm 1), reaches the
 office's hidden side, re-identifies her and follows again; no identity switch, no collision."""
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pytest
 
-HOUSE = Path(__file__).resolve().parents[2] / "missions" / "paper_episode.yaml"
+HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 #: Re-identification must come within this long after the loss (seed 1 measures about 30 s).
 REFIND_WITHIN_S = 45.0
 

@@ -84,7 +84,8 @@ def test_camera_segmentation_sees_the_person_and_sync_moves_it(world) -> None:
     ids = set(np.unique(mask)) & set(bodies.body_ids["bob"])
     assert ids == set(bodies.body_ids["bob"])  # legs, torso and head are all in view
     assert bodies.owner(bodies.body_ids["bob"][3]) == "bob"
-    bob.x += 5.0  # move him out of the view
+    # move him behind the camera, out of the view whichever way he faces
+    bob.x, bob.y = state.x + 4.0 * math.cos(state.theta), state.y + 4.0 * math.sin(state.theta)
     bodies.sync()
     assert not set(np.unique(seg())) & set(bodies.body_ids["bob"])
 
