@@ -1,7 +1,9 @@
 """A MOVE_BASE equivalent for an omnidirectional base: plan on the static map, follow, re-plan.
 
 :class:`Navigator` plans with a :class:`~pfctl.core.planning.GridPlanner` (the static map
-inflated by the robot's radius) and follows the path with a pure-pursuit controller for a
+inflated by the robot's radius) — at once (:meth:`Navigator.start`), or, like move_base, in its
+own control loop after the goal was accepted (:meth:`Navigator.accept`, then the next
+:meth:`Navigator.update`) — and follows the path with a pure-pursuit controller for a
 holonomic base: the command points at a carrot :data:`LOOKAHEAD` metres ahead on the path, at the
 speed limit, slowing down near the goal, while the base turns toward its direction of travel (and
 to the goal's heading at the end). It re-plans when obstacle points (laser returns that are not
@@ -74,38 +76,62 @@ class Navigator:
         self._blockers = np.empty((0, 2))
         self._since_replan = math.inf
         self._rest_at_replan = math.inf
+        self._unplanned = False
+        """A goal was accepted and is not planned yet (the next update plans it)."""
 
     @property
     def status(self) -> NavStatus:
         return self._status
 
-    def start(self, goal: Pose2D, pose: Pose2D) -> None:
-        """Accept a new goal (a running one is PREEMPTED) and plan; ABORTED at once if no path."""
+    def accept(self, goal: Pose2D) -> None:
+        """Take a new goal without planning yet (a running one is PREEMPTED), as move_base
+        accepts a goal and leaves the planning to its own loop: ACTIVE, and the path is planned
+        by the next :meth:`update`; ABORTED at once if the goal itself is not free (a cheap
+        look-up, no search)."""
         if self._status in (NavStatus.ACTIVE, NavStatus.PENDING):
             self._status = NavStatus.PREEMPTED
         self.goal = goal
+        self.path = None
         self.replans = 0
         self.total_replans = 0
         self.reason = ""
         self._blockers = np.empty((0, 2))
         self._since_replan = math.inf
         self._rest_at_replan = math.inf
-        self._status = NavStatus.PENDING
+        self._unplanned = False
+        if not self.planner.is_free((goal.x, goal.y)):
+            self.reason = f"goal ({goal.x:.2f}, {goal.y:.2f}) is inside an obstacle or off the map"
+            self._status = NavStatus.ABORTED
+            return
+        self._unplanned = True
+        self._status = NavStatus.ACTIVE
+
+    def start(self, goal: Pose2D, pose: Pose2D) -> None:
+        """Accept a new goal (a running one is PREEMPTED) and plan from ``pose`` now; ABORTED at
+        once if there is no path."""
+        self.accept(goal)
+        if self._unplanned:
+            self._plan(pose)
+
+    def _plan(self, pose: Pose2D) -> None:
+        """The first plan for the accepted goal; ABORTED if there is no path."""
+        assert self.goal is not None
+        self._unplanned = False
         try:
-            self.path = self.planner.plan((pose.x, pose.y), (goal.x, goal.y))
+            self.path = self.planner.plan((pose.x, pose.y), (self.goal.x, self.goal.y))
         except NoPathError as err:
             self.path = None
             self.reason = str(err)
             self._status = NavStatus.ABORTED
             return
         self._reset_progress()
-        self._status = NavStatus.ACTIVE
 
     def cancel(self) -> None:
         """Drop the goal: PREEMPTED if it was running."""
         if self._status in (NavStatus.ACTIVE, NavStatus.PENDING):
             self._status = NavStatus.PREEMPTED
         self.path = None
+        self._unplanned = False
 
     def _reset_progress(self) -> None:
         self._best = math.inf
@@ -196,10 +222,13 @@ class Navigator:
     def update(self, pose: Pose2D, dt: float, obstacle_points: np.ndarray | None = None) -> Twist2D:
         """The robot-frame command for this control period (STOP unless ACTIVE).
 
+        A goal taken by :meth:`accept` is planned here first (from ``pose``).
         ``obstacle_points`` are map-frame points the robot currently senses (e.g.
         ``LaserScan.points()``); those away from the static map that lie on the path ahead
         trigger a re-plan around them.
         """
+        if self._unplanned and self._status is NavStatus.ACTIVE:
+            self._plan(pose)
         if self._status is not NavStatus.ACTIVE or self.goal is None or self.path is None:
             return STOP
         if self._wait > 0:

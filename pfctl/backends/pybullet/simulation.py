@@ -4,7 +4,10 @@ One :meth:`SimRobot.step` advances one control period (``1 / behavior.tick_hz``)
 no longer than the laser's period. In each sub-step
 
 1. MOVE_BASE (:class:`~pfctl.backends.pybullet.navigation.Navigator`) turns an active goal into a
-   velocity command, using the newest scan to see blockers;
+   velocity command, using the newest scan to see blockers; a goal given by :meth:`SimRobot.
+   navigate` since the last step is planned here, in the first sub-step (``navigate`` itself only
+   takes the goal: ACTIVE, or ABORTED at once when the goal is not free; a goal that cannot be
+   reached is ABORTED by the next step);
 2. the omnidirectional base moves kinematically with the command, clamped to the mission's limits
    (``robot.max_linear_speed`` on the norm of (vx, vy), ``robot.max_angular_speed``); a move
    that would bring the base disc (``robot.radius``) into a wall, a piece of furniture or a
@@ -200,7 +203,10 @@ class SimRobot:
         self.head.set_target(head)
 
     def navigate(self, goal: Pose2D) -> None:
-        self.navigator.start(goal, self.pose)
+        """Take the goal (ACTIVE; ABORTED at once if it is not free space); the path is planned
+        at the start of the next :meth:`step`, as a real robot's move_base plans in its own
+        process, not in the caller's."""
+        self.navigator.accept(goal)
         self._navigating = self.navigator.status is NavStatus.ACTIVE
         if not self._navigating:
             self._cmd = STOP
