@@ -553,6 +553,21 @@ class IdentityConfig(_Model):
     """Colour space of the clothing histograms."""
     bins: tuple[Count, Count, Count] = (16, 4, 4)
     """Histogram bins per channel of ``color_space``."""
+    face_worker: bool = True
+    """Search faces (dlib's detector and embedding, ~90 ms per face) in a worker process off the
+    control loop, not inline in the tick (``pfctl follow``/``search`` in the simulator)."""
+    face_timing: Literal["auto", "deterministic", "realtime"] = "auto"
+    """When the worker's results count: ``deterministic`` (a search of the frame at t counts
+    from t + ``face_latency_s``, waiting for the worker if needed: reproducible episodes),
+    ``realtime`` (whatever has come back, never wait), ``auto``: deterministic in the simulator,
+    realtime on a robot."""
+    face_latency_s: NonNegative = 0.1
+    """Deterministic timing: the latency of a face search, seconds (about one embedding)."""
+    face_miss_limit: Count = 3
+    """After this many face searches of a track in a row found no face (the back of the head),
+    its face is searched only every ``face_miss_backoff_s``."""
+    face_miss_backoff_s: NonNegative = 0.5
+    """How often a track whose face searches keep missing is searched again, seconds."""
 
 
 class PerceptionConfig(_Model):

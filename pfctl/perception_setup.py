@@ -14,8 +14,9 @@ from numpy.typing import ArrayLike
 
 from pfctl.core.belief import BeliefParams, HumanBelief
 from pfctl.core.clothes import ClothesParams
+from pfctl.core.face_worker import FaceWorker
 from pfctl.core.grid import GridGeometry
-from pfctl.core.identity import IdentityParams, TargetIdentifier, TargetProfile
+from pfctl.core.identity import FaceTiming, IdentityParams, TargetIdentifier, TargetProfile
 from pfctl.core.legs import LegDetector, LegParams, load_leg_model
 from pfctl.core.perception import Perception
 from pfctl.core.tracking import MultiPersonTracker, TrackerParams
@@ -46,8 +47,20 @@ def belief_params(mission: Mission) -> BeliefParams:
     return BeliefParams(**mission.belief.model_dump())
 
 
-def identity_params(mission: Mission) -> IdentityParams:
-    """The identification parameters (``perception.identity``)."""
+def face_timing(mission: Mission, robot: Literal["sim", "real"] = "sim") -> FaceTiming:
+    """``perception.identity.face_timing`` with ``auto`` resolved: deterministic in the
+    simulator (reproducible episodes), realtime on a real robot."""
+    timing = mission.perception.identity.face_timing
+    if timing == "auto":
+        return "deterministic" if robot == "sim" else "realtime"
+    return timing
+
+
+def identity_params(
+    mission: Mission, robot: Literal["sim", "real"] = "sim", timing: FaceTiming | None = None
+) -> IdentityParams:
+    """The identification parameters (``perception.identity``); the face worker's timing for
+    ``robot`` (see :func:`face_timing`) unless ``timing`` is given."""
     cfg = mission.perception.identity
     space: Literal["hsv", "rgb", "lab"] = cfg.color_space
     h, s, v = (int(b) for b in cfg.bins)
@@ -55,6 +68,10 @@ def identity_params(mission: Mission) -> IdentityParams:
         face_distance=float(cfg.face_distance),
         clothes_similarity=float(cfg.clothes_similarity),
         clothes=ClothesParams(space, (h, s, v)),
+        face_miss_limit=int(cfg.face_miss_limit),
+        face_miss_backoff_s=float(cfg.face_miss_backoff_s),
+        face_timing=timing or face_timing(mission, robot),
+        face_latency_s=float(cfg.face_latency_s),
     )
 
 
@@ -65,15 +82,30 @@ def build_perception(
     profile: TargetProfile | None = None,
     belief_grid: tuple[GridGeometry, ArrayLike] | None = None,
     leg_model: Path | None = None,
+    face_worker: bool | FaceWorker = False,
+    face_timing: FaceTiming | None = None,
+    robot: Literal["sim", "real"] = "sim",
 ) -> Perception:
     """The mission's perception: its leg model (``leg_model`` overrides
     ``perception.legs.model``; neither: the shipped model), tracker, and — when given — a
     camera ``detector``, a target ``profile`` to identify, and a human belief over
-    ``belief_grid`` = (geometry, blocked mask)."""
+    ``belief_grid`` = (geometry, blocked mask).
+
+    ``face_worker``: True starts a :class:`~pfctl.core.face_worker.FaceWorker` for the
+    identifier's face searches (only with a ``profile`` that has faces), or pass one; False
+    searches faces inline. Its timing is ``face_timing``, else the mission's for ``robot``. The
+    perception then owns the worker: :meth:`Perception.close` stops it.
+    """
     model = load_leg_model(leg_model or mission.perception.legs.model)
     identifier = None
     if profile is not None:
-        identifier = TargetIdentifier(profile, identity_params(mission))
+        params = identity_params(mission, robot, face_timing)
+        worker: FaceWorker | None = None
+        if isinstance(face_worker, FaceWorker):
+            worker = face_worker
+        elif face_worker and params.faces and len(profile.faces) > 0:
+            worker = FaceWorker(params.face)
+        identifier = TargetIdentifier(profile, params, worker=worker)
     belief = None
     if belief_grid is not None:
         geometry, blocked = belief_grid
@@ -92,6 +124,7 @@ def build_perception(
 __all__ = [
     "belief_params",
     "build_perception",
+    "face_timing",
     "identity_params",
     "leg_params",
     "tracker_params",

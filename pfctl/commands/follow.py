@@ -20,7 +20,9 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -39,8 +41,9 @@ from pfctl.core.episode_metrics import (
     follow_metrics,
     search_metrics,
 )
+from pfctl.core.face_worker import FaceWorker, FaceWorkerError
 from pfctl.core.grid import FREE
-from pfctl.core.identity import TargetProfile, learn_profile
+from pfctl.core.identity import FaceTiming, TargetProfile, learn_profile
 from pfctl.core.robot import Observation, Robot
 from pfctl.errors import UserError
 from pfctl.follow_session import EpisodeResult, build_follower, run_follower
@@ -132,10 +135,18 @@ def run_sim_episode(
     stop: Callable[[], bool] | None = None,
     until_found: bool = False,
     recorder: EpisodeRecorder | None = None,
+    face_worker: bool | FaceWorker | None = None,
+    face_timing: FaceTiming | None = None,
 ) -> EpisodeResult:
     """The follower on the simulated robot for ``duration`` s, the truth recorded beside each
     tick; ``until_found`` ends the run when the target is identified (``pfctl search``);
-    ``recorder`` also writes every observation to an episode bag."""
+    ``recorder`` also writes every observation to an episode bag.
+
+    Faces are searched in a worker process when ``face_worker`` (None: the mission's
+    ``perception.identity.face_worker``; or a :class:`FaceWorker` to use), with ``face_timing``
+    (None: the mission's, ``auto`` being deterministic here). The worker is started and has
+    loaded its models before the first tick, and is stopped when the episode ends, however it
+    ends."""
     from pfctl.core.vision import MaskPersonDetector
 
     detector = MaskPersonDetector(
@@ -143,30 +154,50 @@ def run_sim_episode(
         robot.people_bodies.parts(),
         min_pixels=mission.perception.vision.min_pixels,
     )
+    use_worker = mission.perception.identity.face_worker if face_worker is None else face_worker
     perception = build_perception(
         mission,
         detector=detector,
         profile=profile,
         belief_grid=(robot.static_map.geometry, robot.static_map.states() != FREE),
+        face_worker=use_worker,
+        face_timing=face_timing,
+        robot="sim",
     )
-    log = EpisodeLog(target_name=mission.scenario.target)
-    port: Robot = robot if recorder is None else RecordingRobot(robot, recorder)  # type: ignore[assignment]
-    follower = build_follower(mission, port, perception, log)
-    params = _metric_params(mission)
+    try:
+        identifier = perception.identifier
+        if identifier is not None and identifier.worker is not None:
+            identifier.worker.wait_ready()
+        log = EpisodeLog(target_name=mission.scenario.target)
+        port: Robot = robot if recorder is None else RecordingRobot(robot, recorder)  # type: ignore[assignment]
+        follower = build_follower(mission, port, perception, log)
+        params = _metric_params(mission)
 
-    def found(record: TickRecord) -> bool:
-        return record.target_id is not None and search_metrics(log, params).found
+        def found(record: TickRecord) -> bool:
+            return record.target_id is not None and search_metrics(log, params).found
 
-    return run_follower(
-        follower,
-        robot,
-        duration,
-        now=lambda: robot.time,
-        truth=robot.ground_truth,
-        on_tick=on_tick,
-        stop=stop,
-        until=found if until_found else None,
-    )
+        return run_follower(
+            follower,
+            robot,
+            duration,
+            now=lambda: robot.time,
+            truth=robot.ground_truth,
+            on_tick=on_tick,
+            stop=stop,
+            until=found if until_found else None,
+        )
+    finally:
+        perception.close()
+
+
+@contextmanager
+def _worker_errors() -> Iterator[None]:
+    """A face worker that died ends the command with one line on stderr and exit status 1."""
+    try:
+        yield
+    except FaceWorkerError as err:
+        sys.stderr.write(f"pfctl: error: {err}\n")
+        raise typer.Exit(1) from None
 
 
 def _progress(console: Console, duration: float) -> Progress:
@@ -229,7 +260,7 @@ def follow(
     console = Console(stderr=True)
     profile = _profile(loaded, target, seed, console, str(mission))
     robot = _sim_robot(loaded, seed, gui, str(mission))
-    with robot:
+    with robot, _worker_errors():
         recorder = _recorder(record, loaded)
         try:
             with graceful_interrupts() as stop, _progress(console, duration) as bar:
@@ -352,7 +383,7 @@ def search(
     console = Console(stderr=True)
     profile = _profile(loaded, target, seed, console, str(mission))
     robot = _sim_robot(loaded, seed, gui, str(mission))
-    with robot:
+    with robot, _worker_errors():
         hidden_in = hide_target(robot, region)
         with graceful_interrupts() as stop, _progress(console, duration) as bar:
             task = bar.add_task("searching", total=duration)

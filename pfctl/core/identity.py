@@ -13,6 +13,24 @@ through the later frames where the person turns their back, and a mismatching fa
 the same way. When a track has seen faces both ways (a bad detection), the median of its face
 distances decides.
 
+Faces are searched only when it is worth it: until a track has ``face_settled`` face samples, then
+every ``face_recheck_s``; and a track whose last ``face_miss_limit`` searches found no face (the
+back of the head, a face turned away) is searched only every ``face_miss_backoff_s`` until one
+is found again. Clothes are measured on every observation (cheap).
+
+The face search itself (dlib's HOG detector and ResNet embedding, ~75–90 ms per face) runs inline
+by default, or — given a :class:`~pfctl.core.face_worker.FaceWorker` — in a worker process: the
+head crop is submitted and the result folded into the track's evidence when it comes back
+(a track deleted meanwhile is skipped). How results are folded in is ``face_timing``:
+
+- ``deterministic`` (the simulator): a search submitted with the frame stamped t is folded in at
+  the first observation stamped t + ``face_latency_s`` or later, waiting for the worker then if
+  it is not done; at most ``max_in_flight`` searches are out, counted by the identifier itself.
+  Which searches are made and when their results count depend on the frames' stamps only, so a
+  seeded simulation gives the same episode however fast the machine is;
+- ``realtime`` (a real robot): whatever has come back is folded in at each observation, nothing
+  waits; a search the worker refuses (it is busy) is tried again on a later frame.
+
 :class:`TargetProfile` is what ``pfctl learn-target`` writes: the target's upper and lower
 clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, saved as a versioned
 ``.npz`` (no pickles).
@@ -22,11 +40,14 @@ from __future__ import annotations
 
 import enum
 import io
+import itertools
 import math
 import os
+import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING, Literal
 
 import numpy as np
 
@@ -39,9 +60,12 @@ from pfctl.core.clothes import (
     convert,
     histogram_intersection,
 )
-from pfctl.core.faces import EMBEDDING_SIZE, Box, FaceEncoder, FaceParams, face_distance
+from pfctl.core.faces import EMBEDDING_SIZE, Box, Face, FaceEncoder, FaceParams, face_distance
 from pfctl.core.vision import PersonDetection
 from pfctl.errors import UserError
+
+if TYPE_CHECKING:
+    from pfctl.core.face_worker import FaceResult, FaceWorker
 
 #: Version of the profile file format.
 PROFILE_VERSION = 1
@@ -49,6 +73,14 @@ PROFILE_VERSION = 1
 MAX_PROFILE_FACES = 32
 #: A head region narrower than this (pixels) is not searched for a face (too far).
 MIN_HEAD_PX = 12
+#: Stamps this close count as equal (simulated clocks add up float steps).
+STAMP_EPS = 1e-6
+
+#: Numbers the identifiers, for their job keys.
+_IDENTIFIERS = itertools.count()
+
+FaceTiming = Literal["deterministic", "realtime"]
+"""When a face worker's results are folded in (module docstring)."""
 
 
 @dataclass(frozen=True)
@@ -68,6 +100,16 @@ class IdentityParams:
     ``face_recheck_s`` (an embedding costs ~90 ms on one core; see benchmarks/bench_identity)."""
     face_recheck_s: float = 1.0
     """How often a settled track's face is embedded again, seconds."""
+    face_miss_limit: int = 3
+    """After this many face searches in a row found no face (the back of the head), the track
+    is searched only every ``face_miss_backoff_s`` until a face is found again."""
+    face_miss_backoff_s: float = 0.5
+    """How often a track whose face searches keep missing is searched, seconds."""
+    face_timing: FaceTiming = "deterministic"
+    """With a face worker: ``deterministic`` (simulator) or ``realtime`` (robot)."""
+    face_latency_s: float = 0.1
+    """With a face worker in ``deterministic`` timing: a search of the frame stamped t counts
+    from the first observation stamped t + this (about what an embedding takes)."""
 
 
 @dataclass(frozen=True)
@@ -101,6 +143,16 @@ def _head_cut(detection: PersonDetection, shape: tuple[int, ...]) -> bool:
     return x0 <= 0 or y0 <= 0 or x1 >= shape[1] or y1 >= shape[0]
 
 
+def face_region(detection: PersonDetection, shape: tuple[int, ...]) -> Box | None:
+    """The :func:`head_region` to search for the detection's face in an image of ``shape``, or
+    None when it is not worth searching: the head box touches the border (a cut face embeds
+    badly) or the region is narrower than :data:`MIN_HEAD_PX`."""
+    if _head_cut(detection, shape):
+        return None
+    region = head_region(detection)
+    return region if region[2] - region[0] >= MIN_HEAD_PX else None
+
+
 def describe(
     rgb: np.ndarray,
     detection: PersonDetection,
@@ -120,12 +172,11 @@ def describe(
     upper = color_histogram(img, upper_mask, params.clothes, converted=True)
     lower = color_histogram(img, lower_mask, params.clothes, converted=True)
     face = face_box = None
-    if encoder is not None and params.faces and not _head_cut(detection, shape):
-        region = head_region(detection)
-        if region[2] - region[0] >= MIN_HEAD_PX:
-            faces = encoder.detect(rgb, region)
-            if faces:
-                face, face_box = faces[0].embedding, faces[0].box
+    region = face_region(detection, shape) if encoder is not None and params.faces else None
+    if encoder is not None and region is not None:
+        faces = encoder.detect(rgb, region)
+        if faces:
+            face, face_box = faces[0].embedding, faces[0].box
     return Appearance(upper, lower, face, face_box)
 
 
@@ -304,17 +355,63 @@ class TrackIdentity:
     legs_seen: int
     last_seen: float
     face_box: Box | None = None
-    """Where the face was found in the latest observation, if any."""
+    """Where the face was found, when a face was folded in at this identity's time (inline: in
+    this observation's frame; with a worker: in the frame the search was submitted from)."""
 
 
 @dataclass
 class _Evidence:
     face_distances: list[float] = field(default_factory=list)
     last_face: float = -math.inf
+    """Stamp of the frame of the newest face sample."""
     clothes: list[float] = field(default_factory=list)
     observations: int = 0
     legs_seen: int = 0
     last_seen: float = -math.inf
+    last_search: float = -math.inf
+    """Stamp of the frame of the newest face search (made or submitted)."""
+    face_misses: int = 0
+    """Face searches in a row that found no face."""
+    face_box: Box | None = None
+    face_box_at: float = math.nan
+    """When ``face_box`` was folded in: identities made then report it."""
+    job: tuple[int, int] | None = None
+    """The face search of this track out at the worker, if any."""
+
+
+@dataclass(frozen=True)
+class _Job:
+    """A face search out at the worker."""
+
+    job: tuple[int, int]
+    track_id: int
+    evidence: _Evidence
+    stamp: float
+    """Stamp of the frame the head was cropped from."""
+    due: float
+    """Deterministic timing: folded in at the first observation stamped this or later."""
+
+
+@dataclass
+class FaceSearchStats:
+    """What the identifier did about faces (counters since it was made)."""
+
+    inline: int = 0
+    """Searches run inline (no worker)."""
+    submitted: int = 0
+    """Searches submitted to the worker."""
+    refused: int = 0
+    """Searches the worker refused (busy; tried again on a later frame)."""
+    deferred: int = 0
+    """Searches due but not submitted because ``max_in_flight`` were out (deterministic)."""
+    folded: int = 0
+    """Worker results folded into a track's evidence."""
+    discarded: int = 0
+    """Worker results whose track was deleted meanwhile."""
+    backed_off: int = 0
+    """Searches skipped because the track's searches kept missing (``face_miss_limit``)."""
+    waited_s: float = 0.0
+    """Wall time spent waiting for the worker (deterministic timing), seconds."""
 
 
 class TargetIdentifier:
@@ -322,10 +419,16 @@ class TargetIdentifier:
 
     ``observe(track_id, t, has_legs, detection, rgb)`` adds one observation of a track (the
     detection associated with it in this frame, or None when the camera did not see it) and
-    returns the track's current :class:`TrackIdentity`. A track is a candidate only once the leg
-    detector has confirmed it (``has_legs``) at least once. Faces are searched on every
-    observation until the track has ``face_settled`` face samples, then every
-    ``face_recheck_s`` (clothes are measured every time).
+    returns the track's current :class:`TrackIdentity`; :meth:`observe_frame` does the same for
+    all the tracks one frame saw (converting the frame's colours once, and giving the worker's
+    few slots to the tracks searched longest ago). A track is a candidate only once the leg
+    detector has confirmed it (``has_legs``) at least once. Faces are searched as the module
+    docstring says (settled tracks every ``face_recheck_s``, missing ones backed off); clothes
+    are measured every time.
+
+    ``worker`` (a :class:`~pfctl.core.face_worker.FaceWorker`): faces are searched there, with
+    ``params.face_timing``; without one they are searched inline with ``encoder`` (default: a
+    :class:`~pfctl.core.faces.FaceEncoder` of ``params.face``). :meth:`close` closes the worker.
     """
 
     def __init__(
@@ -333,14 +436,39 @@ class TargetIdentifier:
         profile: TargetProfile,
         params: IdentityParams | None = None,
         encoder: FaceEncoder | None = None,
+        *,
+        worker: FaceWorker | None = None,
     ) -> None:
         self.params = params or IdentityParams(clothes=profile.clothes)
         profile.check_params(self.params)
+        if self.params.face_timing not in ("deterministic", "realtime"):
+            raise ValueError(f"face_timing: unknown {self.params.face_timing!r}")
         self.profile = profile
         use_faces = self.params.faces and len(profile.faces) > 0
-        self.encoder = (encoder or FaceEncoder(self.params.face)) if use_faces else None
+        self.worker = worker if use_faces else None
+        self.encoder = (
+            (encoder or FaceEncoder(self.params.face)) if use_faces and worker is None else None
+        )
+        self.face_stats = FaceSearchStats()
         self._tracks: dict[int, _Evidence] = {}
         self._latest: dict[int, TrackIdentity] = {}
+        self._jobs: dict[tuple[int, int], _Job] = {}
+        """Searches out at the worker, in the order submitted."""
+        self._arrived: dict[tuple[int, int], FaceResult] = {}
+        self._next_job = 0
+        self._key = next(_IDENTIFIERS)
+        """Job keys are ``(key, n)``: several identifiers may share one worker."""
+        self._given_worker = worker
+
+    @property
+    def searches_faces(self) -> bool:
+        """Whether faces are searched at all (inline or in a worker)."""
+        return self.encoder is not None or self.worker is not None
+
+    @property
+    def pending(self) -> int:
+        """Face searches out at the worker (submitted, not folded in yet)."""
+        return len(self._jobs)
 
     def observe(
         self,
@@ -352,29 +480,176 @@ class TargetIdentifier:
         appearance: Appearance | None = None,
     ) -> TrackIdentity:
         """Add one observation of ``track_id`` at time ``t``; the updated identity. Pass
-        ``appearance`` when it is already measured (else it is measured from ``rgb``)."""
+        ``appearance`` when it is already measured (else it is measured from ``rgb``; its face
+        is then searched only when due)."""
+        if appearance is not None and detection is not None:
+            self.update(t)
+            ev = self._observed(track_id, t, has_legs)
+            self._add_clothes(ev, appearance)
+            if appearance.face is not None and self.searches_faces:
+                self._fold_face(ev, t, appearance.face, appearance.face_box, t)
+            return self._identify(track_id, ev, t)
+        return self.observe_frame(t, rgb, [(track_id, has_legs, detection)])[0]
+
+    def observe_frame(
+        self,
+        t: float,
+        rgb: np.ndarray | None,
+        sightings: Sequence[tuple[int, bool, PersonDetection | None]],
+    ) -> list[TrackIdentity]:
+        """Add one observation per ``(track_id, has_legs, detection)`` of the frame ``rgb``
+        stamped ``t`` (detection None: the camera did not see that track); the updated
+        identities, in order. Face searches that are due go to the tracks searched longest ago
+        first (they matter when a worker has few slots)."""
+        self.update(t)
+        seen: list[tuple[int, _Evidence, PersonDetection | None]] = []
+        for track_id, has_legs, _ in sightings:
+            seen.append((track_id, self._observed(track_id, t, has_legs), None))
+        if rgb is not None:
+            converted = None
+            for k, (track_id, ev, _) in enumerate(seen):
+                detection = sightings[k][2]
+                if detection is None:
+                    continue
+                if converted is None:
+                    converted = convert(rgb, self.params.clothes.color_space)
+                self._add_clothes(ev, describe(rgb, detection, self.params, None, converted))
+                seen[k] = (track_id, ev, detection)
+            wanted = [
+                (ev.last_search, k)
+                for k, (_, ev, detection) in enumerate(seen)
+                if detection is not None and self._face_due(ev, t)
+            ]
+            for _, k in sorted(wanted):
+                track_id, ev, detection = seen[k]
+                assert detection is not None
+                region = face_region(detection, rgb.shape)
+                if region is not None:
+                    self._search(track_id, ev, t, rgb, region)
+        return [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
+
+    def update(self, t: float) -> None:
+        """Fold in the worker's results that count at ``t`` (``face_timing``); nothing without
+        a worker. Called by every observation; call it when a frame shows nobody, too."""
+        if self.worker is None or not self._jobs:
+            return
+        for result in self.worker.poll():
+            if result.job in self._jobs:  # not another identifier's
+                self._arrived[result.job] = result  # type: ignore[index]
+        if self.params.face_timing == "deterministic":
+            due = [j for j in self._jobs.values() if j.due <= t + STAMP_EPS]
+            for job in due:
+                result = self._arrived.pop(job.job, None)
+                if result is None:
+                    t0 = time.perf_counter()
+                    result = self.worker.wait(job.job)
+                    self.face_stats.waited_s += time.perf_counter() - t0
+                self._finish(job, result, t)
+        else:
+            arrived, self._arrived = self._arrived, {}
+            for job_id, result in arrived.items():
+                job = self._jobs.get(job_id)
+                if job is not None:
+                    self._finish(job, result, t)
+
+    def close(self) -> None:
+        """Close the face worker (if one was given); safe to call twice."""
+        if self._given_worker is not None:
+            self._given_worker.close()
+        self._jobs.clear()
+        self._arrived.clear()
+
+    # -- internals ----------------------------------------------------------------------------
+
+    def _observed(self, track_id: int, t: float, has_legs: bool) -> _Evidence:
         ev = self._tracks.setdefault(track_id, _Evidence())
         ev.observations += 1
         ev.last_seen = t
         ev.legs_seen += bool(has_legs)
-        face_box = None
-        if detection is not None and (appearance is not None or rgb is not None):
-            if appearance is None:
-                assert rgb is not None
-                settled = len(ev.face_distances) >= self.params.face_settled
-                due = not settled or t - ev.last_face >= self.params.face_recheck_s
-                encoder = self.encoder if due else None
-                appearance = describe(rgb, detection, self.params, encoder)
-            s = self.profile.similarity(appearance)
-            if s is not None:
-                ev.clothes.append(s)
-            if appearance.face is not None and self.encoder is not None:
-                d = self.profile.face_distance(appearance.face)
-                if d is not None:
-                    ev.face_distances.append(d)
-                    ev.last_face = t
-                    face_box = appearance.face_box
-        identity = self._decide(track_id, ev, face_box)
+        return ev
+
+    def _add_clothes(self, ev: _Evidence, appearance: Appearance) -> None:
+        s = self.profile.similarity(appearance)
+        if s is not None:
+            ev.clothes.append(s)
+
+    def _face_due(self, ev: _Evidence, t: float) -> bool:
+        """Whether the track's face should be searched in the frame stamped ``t``."""
+        p = self.params
+        if not self.searches_faces or ev.job is not None:
+            return False
+        settled = len(ev.face_distances) >= p.face_settled
+        if settled and t - ev.last_face < p.face_recheck_s - STAMP_EPS:
+            return False
+        if ev.face_misses >= p.face_miss_limit and (
+            t - ev.last_search < p.face_miss_backoff_s - STAMP_EPS
+        ):
+            self.face_stats.backed_off += 1
+            return False
+        return True
+
+    def _search(self, track_id: int, ev: _Evidence, t: float, rgb: np.ndarray, region: Box) -> None:
+        """Search ``region`` for the track's face: inline now, or submitted to the worker."""
+        if self.worker is None:
+            assert self.encoder is not None
+            ev.last_search = t
+            self.face_stats.inline += 1
+            self._fold_faces(ev, t, self.encoder.detect(rgb, region), t)
+            return
+        if self.params.face_timing == "deterministic" and len(self._jobs) >= (
+            self.worker.max_in_flight
+        ):
+            self.face_stats.deferred += 1
+            return
+        job = (self._key, self._next_job)
+        if not self.worker.submit(job, rgb, region):
+            self.face_stats.refused += 1
+            if self.params.face_timing == "realtime":
+                return  # busy: the track is tried again on a later frame
+            # deterministic: only someone else's jobs can fill the worker; wait for a slot
+            self.worker.wait_slot()
+            if not self.worker.submit(job, rgb, region):  # pragma: no cover - cannot happen
+                raise RuntimeError("face worker refused a job with a free slot")
+        self._next_job += 1
+        self.face_stats.submitted += 1
+        ev.last_search = t
+        ev.job = job
+        due = t + self.params.face_latency_s
+        self._jobs[job] = _Job(job, track_id, ev, t, due)
+
+    def _finish(self, job: _Job, result: FaceResult, now: float) -> None:
+        """A worker result: into its track's evidence, unless the track was deleted."""
+        del self._jobs[job.job]
+        job.evidence.job = None
+        if self._tracks.get(job.track_id) is not job.evidence:
+            self.face_stats.discarded += 1
+            return
+        self.face_stats.folded += 1
+        self._fold_faces(job.evidence, job.stamp, result.faces, now)
+        self._identify(job.track_id, job.evidence, now)
+
+    def _fold_faces(self, ev: _Evidence, stamp: float, faces: Sequence[Face], now: float) -> None:
+        """The outcome of one face search of the frame stamped ``stamp`` (best face first)."""
+        if faces:
+            self._fold_face(ev, stamp, faces[0].embedding, faces[0].box, now)
+        else:
+            ev.face_misses += 1
+
+    def _fold_face(
+        self, ev: _Evidence, stamp: float, embedding: np.ndarray, box: Box | None, now: float
+    ) -> None:
+        d = self.profile.face_distance(embedding)
+        if d is None:
+            return
+        ev.face_distances.append(d)
+        ev.last_face = max(ev.last_face, stamp)
+        ev.face_misses = 0
+        ev.face_box, ev.face_box_at = box, now
+
+    def _identify(self, track_id: int, ev: _Evidence, now: float) -> TrackIdentity:
+        """The track's identity now (and remembered as its latest)."""
+        box = ev.face_box if ev.face_box_at == now else None
+        identity = self._decide(track_id, ev, box)
         self._latest[track_id] = identity
         return identity
 
@@ -444,11 +719,14 @@ __all__ = [
     "PROFILE_VERSION",
     "Appearance",
     "Decision",
+    "FaceSearchStats",
+    "FaceTiming",
     "IdentityParams",
     "TargetIdentifier",
     "TargetProfile",
     "TrackIdentity",
     "describe",
+    "face_region",
     "head_region",
     "learn_profile",
 ]

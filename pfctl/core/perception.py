@@ -8,8 +8,9 @@ message, in the order the follower needs them:
   (``laser`` detections, the scan's field of view with its returns as occluders);
 - an **RGB-D frame** → a :class:`~pfctl.core.vision.PersonDetector` → 3-D people →
   the same tracker (``camera`` detections, the camera's floor wedge) → Algorithm 2
-  (:class:`~pfctl.core.identity.TargetIdentifier`) for every track the camera saw, with "has
-  legs" meaning the laser has associated leg detections with that track; and, when a
+  (:class:`~pfctl.core.identity.TargetIdentifier`, one call per frame) for every track the
+  camera saw, with "has legs" meaning the laser has associated leg detections with that track
+  (with a face worker, its results are folded in there too); and, when a
   :class:`~pfctl.core.belief.HumanBelief` is given, the Eq. 4 update of the camera's view.
 
 The target is the track Algorithm 2 names, as long as the tracker still has it.
@@ -82,14 +83,19 @@ class Perception:
         detections = [Detection(d.position[0], d.position[1], d.score) for d in people]
         ids = self.tracker.update("camera", detections, fov, frame.stamp)
         self._forget_deleted()
-        sightings = []
-        for person, track_id in zip(people, ids, strict=True):
-            identity = None
-            if self.identifier is not None and track_id is not None:
-                identity = self.identifier.observe(
-                    track_id, frame.stamp, track_id in self._leg_tracks, person, frame.rgb
-                )
-            sightings.append(CameraSighting(person, track_id, identity))
+        identities: dict[int, TrackIdentity] = {}
+        if self.identifier is not None:
+            seen = [
+                (track_id, track_id in self._leg_tracks, person)
+                for person, track_id in zip(people, ids, strict=True)
+                if track_id is not None
+            ]
+            found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen)
+            identities = {s[0]: identity for s, identity in zip(seen, found, strict=True)}
+        sightings = [
+            CameraSighting(person, track_id, None if track_id is None else identities.get(track_id))
+            for person, track_id in zip(people, ids, strict=True)
+        ]
         if self.belief is not None:
             self.belief.update(fov, [d.position[:2] for d in people], frame.stamp)
         self.last_sightings = tuple(sightings)
@@ -123,6 +129,11 @@ class Perception:
     def has_legs(self, track_id: int) -> bool:
         """Whether the laser has associated leg detections with ``track_id``."""
         return track_id in self._leg_tracks
+
+    def close(self) -> None:
+        """Release what the perception holds (the identifier's face worker); safe to call twice."""
+        if self.identifier is not None:
+            self.identifier.close()
 
 
 def track_rows(
