@@ -93,8 +93,10 @@ def build_perception(
 
     ``face_worker``: True starts a :class:`~pfctl.core.face_worker.FaceWorker` for the
     identifier's face searches (only with a ``profile`` that has faces), or pass one; False
-    searches faces inline. Its timing is ``face_timing``, else the mission's for ``robot``. The
-    perception then owns the worker: :meth:`Perception.close` stops it.
+    searches faces inline. Its timing is ``face_timing``, else the mission's for ``robot``; with
+    ``realtime`` timing the worker runs at the lowest priority (nice 19, ``SCHED_IDLE``), with
+    ``deterministic`` at the normal one (the loop waits for it). The perception then owns the
+    worker: :meth:`Perception.close` stops it.
     """
     model = load_leg_model(leg_model or mission.perception.legs.model)
     identifier = None
@@ -104,7 +106,11 @@ def build_perception(
         if isinstance(face_worker, FaceWorker):
             worker = face_worker
         elif face_worker and params.faces and len(profile.faces) > 0:
-            worker = FaceWorker(params.face)
+            # realtime: the loop never waits for the worker, which runs in its idle time at the
+            # lowest priority; deterministic: the loop waits for due results, so the worker must
+            # not starve behind other processes (SCHED_IDLE would invert the priorities)
+            realtime = params.face_timing == "realtime"
+            worker = FaceWorker(params.face, nice=19 if realtime else 0, idle=realtime)
         identifier = TargetIdentifier(profile, params, worker=worker)
     belief = None
     if belief_grid is not None:
