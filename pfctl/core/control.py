@@ -29,6 +29,7 @@ from pfctl.core.grid import GridGeometry
 from pfctl.core.robot import STOP, HeadState, HeadTarget, Pose2D, Twist2D, wrap_angle
 
 __all__ = [
+    "KNOWN_RADIUS",
     "MODES",
     "BaseCommand",
     "BaseController",
@@ -37,9 +38,14 @@ __all__ = [
     "choose_gaze",
     "gaze_angles",
     "sweep_pan",
+    "unknown_peak",
 ]
 
 _TWO_PI = 2.0 * math.pi
+
+#: A belief peak or leg candidate this close (m) to a person identified as not the target is
+#: that person: the gaze does not spend itself on them.
+KNOWN_RADIUS = 1.0
 
 #: The base command modes, in the order :meth:`BaseController.follow` considers them.
 MODES = ("stop", "hold", "turn", "go_straight", "move_base")
@@ -253,12 +259,21 @@ def choose_gaze(
     leg_candidates: ArrayLike,
     robot_xy: ArrayLike,
     belief_threshold: float = 0.3,
+    *,
+    known_xy: ArrayLike = (),
+    known_radius: float = KNOWN_RADIUS,
+    ahead: Sequence[float] | None = None,
 ) -> tuple[tuple[float, float] | None, str]:
-    """Where to look and why (§II-E): the target, else the human belief, else leg candidates.
+    """Where to look and why (§II-E): the target, else the human belief, else leg candidates,
+    else where the robot is going.
 
     Returns ``((x, y), source)``: the target's position if known → ``"target"``; else the belief
     peak ``(x, y, p)`` if ``p ≥ belief_threshold`` → ``"belief"``; else the leg candidate
-    (``(n, 2)``) nearest ``robot_xy`` → ``"legs"``; else ``(None, "none")``.
+    (``(n, 2)``) nearest ``robot_xy`` → ``"legs"``, leaving out candidates within
+    ``known_radius`` of ``known_xy`` (people already identified as not the target: looking at
+    them again tells nothing); else ``ahead`` (the navigation goal of a search, so the camera
+    sees the places the robot drives into) → ``"goal"``; else ``(None, "none")``. The caller
+    picks a belief peak away from ``known_xy`` (:func:`unknown_peak`).
     """
     if target_xy is not None:
         t = np.asarray(target_xy, dtype=float).ravel()
@@ -268,11 +283,33 @@ def choose_gaze(
         if p >= belief_threshold:
             return (x, y), "belief"
     legs = np.asarray(leg_candidates, dtype=float).reshape(-1, 2)
+    known = np.asarray(known_xy, dtype=float).reshape(-1, 2)
+    if len(legs) and len(known):
+        near = np.linalg.norm(legs[:, None, :] - known[None, :, :], axis=2).min(axis=1)
+        legs = legs[near > known_radius]
     if len(legs):
         r = np.asarray(robot_xy, dtype=float).ravel()[:2]
         i = int(np.argmin(np.linalg.norm(legs - r, axis=1)))
         return (float(legs[i, 0]), float(legs[i, 1])), "legs"
+    if ahead is not None:
+        return (float(ahead[0]), float(ahead[1])), "goal"
     return None, "none"
+
+
+def unknown_peak(
+    peaks: Sequence[Sequence[float]],
+    known_xy: ArrayLike = (),
+    known_radius: float = KNOWN_RADIUS,
+) -> tuple[float, float, float] | None:
+    """The first belief peak ``(x, y, p)`` of ``peaks`` (by decreasing p) farther than
+    ``known_radius`` from every person in ``known_xy`` (identified as not the target): the
+    human belief marks people, and a person already identified is not worth a look."""
+    known = np.asarray(known_xy, dtype=float).reshape(-1, 2)
+    for peak in peaks:
+        x, y, p = (float(v) for v in peak)
+        if not len(known) or np.linalg.norm(known - (x, y), axis=1).min() > known_radius:
+            return x, y, p
+    return None
 
 
 def sweep_pan(elapsed: float, seconds: float, amplitude: float) -> float:

@@ -43,15 +43,20 @@ from pfctl.core.behavior.blackboard import (
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS, leaf_factory
 from pfctl.core.behavior.skills import SearchParams, Skills
 from pfctl.core.behavior.tree import build_tree
-from pfctl.core.control import ControlParams
+from pfctl.core.control import KNOWN_RADIUS, ControlParams, unknown_peak
 from pfctl.core.episode import EpisodeLog, PredictionRecord, TickRecord, WaypointRecord
 from pfctl.core.grid import InverseSensorModel, OccupancyGrid
+from pfctl.core.identity import Decision
+from pfctl.core.paths import line_of_sight
 from pfctl.core.perception import Perception
 from pfctl.core.planning import GridPlanner
 from pfctl.core.prediction import MIN_POINTS, PredictionError, make_model
 from pfctl.core.prediction_clip import clip_prediction
 from pfctl.core.regions import RegionMap
 from pfctl.core.robot import STOP, Observation, Robot
+
+#: Belief peaks considered for the gaze (the best one away from known people wins).
+PEAK_CANDIDATES = 8
 
 
 @dataclass(frozen=True)
@@ -229,15 +234,50 @@ class Follower:
         w.skills = self.skills
 
     def _gaze(self, target: TargetState | None) -> None:
+        """The head when no leaf claimed it (§II-E gaze priority), not spent on people
+        Algorithm 2 has already identified as not the target."""
+        known = self._known_others(target)
         belief = self.perception.belief
         peak = None
         if belief is not None:
-            best = belief.most_likely(1)
-            if best and best[0][2] >= self.params.belief_threshold:
-                peak = best[0]
+            peaks = belief.most_likely(PEAK_CANDIDATES, min_separation=KNOWN_RADIUS)
+            peaks = [p for p in peaks if p[2] >= self.params.belief_threshold]
+            peak = unknown_peak(self._in_sight(peaks), known)
         legs = self.perception.last_legs
         legs_xy = [(c.x, c.y) for c in legs.people] if legs is not None else []
-        self.skills.default_gaze(target.xy if target is not None else None, peak, legs_xy)
+        target_xy = target.xy if target is not None else None
+        self.skills.default_gaze(target_xy, peak, legs_xy, known)
+
+    def _in_sight(
+        self, peaks: list[tuple[float, float, float]]
+    ) -> list[tuple[float, float, float]]:
+        """The belief peaks the camera could see from here: within its range and with a clear
+        line of sight over the static map (a peak behind walls — a person seen there long ago —
+        cannot be checked by turning the head, so it does not draw the gaze)."""
+        belief = self.perception.belief
+        if not peaks or belief is None or belief.blocked is None:
+            return peaks
+        here = np.array([self.skills.pose.x, self.skills.pose.y])
+        xy = np.array([(x, y) for x, y, _ in peaks])
+        near = np.linalg.norm(xy - here, axis=1) <= self.perception.camera_range[1]
+        clear = line_of_sight(belief.blocked, belief.geometry, here, xy)
+        return [p for p, ok in zip(peaks, near & clear, strict=True) if ok]
+
+    def _known_others(self, target: TargetState | None) -> list[tuple[float, float]]:
+        """Where the tracks identified as not the target are."""
+        identifier = self.perception.identifier
+        if identifier is None:
+            return []
+        others = {
+            tid
+            for tid, ident in identifier.identities().items()
+            if ident.decision is Decision.NOT_TARGET
+        }
+        return [
+            t.position
+            for t in self.perception.tracks()
+            if t.id in others and (target is None or t.id != target.track_id)
+        ]
 
     def _record(
         self, now: float, obs: Observation, target: TargetState | None, visible: bool

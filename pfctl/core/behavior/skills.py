@@ -249,12 +249,22 @@ class Skills:
         target_xy: tuple[float, float] | None,
         belief_peak: tuple[float, float, float] | None,
         legs_xy: Sequence[tuple[float, float]],
+        known_xy: Sequence[tuple[float, float]] = (),
     ) -> None:
         """The paper's gaze priority when no leaf claimed the head: the target, else the
-        highest human belief, else the nearest leg candidate, else straight ahead."""
+        highest human belief, else the nearest leg candidate not of a person in ``known_xy``
+        (identified as not the target), else the navigation goal being driven to, else straight
+        ahead (:func:`~pfctl.core.control.choose_gaze`)."""
         if self.head_claimed:
             return
-        point, source = choose_gaze(target_xy, belief_peak, legs_xy, (self.pose.x, self.pose.y))
+        point, source = choose_gaze(
+            target_xy,
+            belief_peak,
+            legs_xy,
+            (self.pose.x, self.pose.y),
+            known_xy=known_xy,
+            ahead=self.nav_goal,
+        )
         if point is None:
             self.set_pan(0.0, 0.0, source="none")
         else:
