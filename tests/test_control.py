@@ -15,6 +15,7 @@ from pfctl.core.control import (
     choose_gaze,
     gaze_angles,
     sweep_pan,
+    unknown_peak,
 )
 from pfctl.core.grid import GridGeometry
 from pfctl.core.robot import STOP, HeadState, HeadTarget, Pose2D, Twist2D, wrap_angle
@@ -229,6 +230,32 @@ def test_choose_gaze_priorities() -> None:
     assert choose_gaze(None, None, legs, (-1.5, 0.0)) == ((-2.0, 0.0), "legs")
     assert choose_gaze(None, (1.0, 2.0, 0.5), [], robot, belief_threshold=0.6) == (None, "none")
     assert choose_gaze(None, None, np.empty((0, 2)), robot) == (None, "none")
+
+
+def test_gaze_skips_people_already_rejected_and_looks_where_the_search_goes() -> None:
+    robot = (0.0, 0.0)
+    legs = [(1.0, 1.0), (3.0, 0.0)]
+    known = [(1.2, 1.1)]  # the person at (1, 1) was identified as not the target
+    assert choose_gaze(None, None, legs, robot, known_xy=known) == ((3.0, 0.0), "legs")
+    everyone = [(1.2, 1.1), (3.0, 0.4)]
+    assert choose_gaze(None, None, legs, robot, known_xy=everyone) == (None, "none")
+    ahead = (4.0, -2.0)
+    assert choose_gaze(None, None, legs, robot, known_xy=everyone, ahead=ahead) == (
+        ahead,
+        "goal",
+    )
+    # a belief peak still comes first, then legs, then the goal
+    assert choose_gaze(None, (5.0, 5.0, 0.8), legs, robot, ahead=ahead)[1] == "belief"
+    assert choose_gaze(None, None, legs, robot, ahead=ahead)[1] == "legs"
+
+
+def test_unknown_peak_is_the_best_peak_away_from_known_people() -> None:
+    peaks = [(1.0, 1.0, 0.99), (4.0, 0.0, 0.7), (6.0, 0.0, 0.5)]
+    assert unknown_peak(peaks) == (1.0, 1.0, 0.99)
+    assert unknown_peak(peaks, [(1.3, 1.2)]) == (4.0, 0.0, 0.7)
+    assert unknown_peak(peaks, [(1.3, 1.2), (4.5, 0.5)]) == (6.0, 0.0, 0.5)
+    assert unknown_peak(peaks, [(1.05, 1.0)], known_radius=0.01) == (1.0, 1.0, 0.99)
+    assert unknown_peak([], [(0.0, 0.0)]) is None
 
 
 def test_sweep_pan_profile() -> None:

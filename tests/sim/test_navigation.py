@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 import shapely
 
-from pfctl.backends.pybullet.navigation import Navigator
+from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
 from pfctl.core.planning import GridPlanner
 from pfctl.core.robot import NavStatus, Pose2D, Twist2D
 from pfctl.core.walls import rasterize_house, wall_footprint
@@ -134,3 +134,43 @@ def test_cancel_and_new_goal(mission: Mission, planner: GridPlanner) -> None:
     nav.cancel()
     assert nav.status is NavStatus.PREEMPTED
     assert nav.update(Pose2D(1.0, 3.3), DT) == Twist2D()
+
+
+def test_keep_clear_slides_along_walls_and_stops_short_of_people() -> None:
+    here, r = np.array([0.0, 0.0]), 0.2
+    none = np.empty((0, 2))
+    v = np.array([0.3, 0.1])
+    assert np.allclose(keep_clear(v, here, none, none, r), v)  # nothing near: unchanged
+    wall = np.array([[r + WALL_MARGIN - 0.01, 0.0]])  # a wall point just ahead
+    assert np.allclose(keep_clear(v, here, none, wall, r), [0.0, 0.1])  # slides along it
+    far_wall = np.array([[r + WALL_MARGIN + 0.05, 0.0]])
+    assert np.allclose(keep_clear(v, here, none, far_wall, r), v)
+    leg = np.array([[0.3, 0.3]])  # a person's leg within the radius + PERSON_MARGIN
+    assert np.hypot(*leg[0]) < r + PERSON_MARGIN
+    out = keep_clear(v, here, leg, none, r)
+    assert out @ (leg[0] / np.linalg.norm(leg[0])) <= 1e-12  # no approach
+    assert np.allclose(keep_clear(-v, here, leg, none, r), -v)  # moving away is free
+    # a doorway: jambs left and right, straight through stays possible
+    jambs = np.array([[0.0, r + 0.03], [0.0, -(r + 0.03)]])
+    assert np.allclose(keep_clear(np.array([0.3, 0.0]), here, none, jambs, r), [0.3, 0.0])
+    # two walls in a corner: neither is approached after the two passes
+    corner = np.array([[r, 0.0], [0.0, r]])
+    out = keep_clear(np.array([0.3, 0.3]), here, none, corner, r)
+    assert out[0] <= 1e-12 and out[1] <= 1e-12
+
+
+def test_navigator_does_not_drive_into_a_person_standing_on_its_path(
+    planner: GridPlanner,
+) -> None:
+    nav = Navigator(planner, 0.6, 1.2)
+    pose = Pose2D(1.0, 5.0, 0.0)
+    nav.start(Pose2D(6.0, 5.0, 0.0), pose)  # along the hall
+    person = np.array([1.6, 5.0])
+    legs = person + np.array([[0.0, 0.1], [0.0, -0.1]])
+    for _ in range(40):
+        cmd = nav.update(pose, DT, legs)
+        c, s = math.cos(pose.theta), math.sin(pose.theta)
+        vx, vy = c * cmd.vx - s * cmd.vy, s * cmd.vx + c * cmd.vy
+        pose = Pose2D(pose.x + vx * DT, pose.y + vy * DT, pose.theta + cmd.wz * DT)
+        gap = np.linalg.norm(legs - (pose.x, pose.y), axis=1).min()
+        assert gap >= planner.robot_radius + PERSON_MARGIN - 0.07  # one step of overshoot

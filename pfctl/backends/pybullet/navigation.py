@@ -6,10 +6,13 @@ own control loop after the goal was accepted (:meth:`Navigator.accept`, then the
 :meth:`Navigator.update`) — and follows the path with a pure-pursuit controller for a
 holonomic base: the command points at a carrot :data:`LOOKAHEAD` metres ahead on the path, at the
 speed limit, slowing down near the goal, while the base turns toward its direction of travel (and
-to the goal's heading at the end). It re-plans when obstacle points (laser returns that are not
-part of the static map) lie on the path ahead, or when the robot makes no progress for
-:data:`STUCK_TIME` seconds, marking those points as obstacles; after :data:`MAX_REPLANS`
-re-plans without success the goal is ABORTED. Pure numpy: no pybullet.
+to the goal's heading at the end). Like move_base's local planner it never drives into what the
+laser senses: :func:`keep_clear` removes the part of the command that would bring the base
+closer than a margin to a sensed point (sliding along a wall, stopping short of a person; the
+pure pursuit cuts the corners of a path, and people walk across it). It re-plans when obstacle
+points (laser returns that are not part of the static map) lie on the path ahead, or when the
+robot makes no progress for :data:`STUCK_TIME` seconds, marking those points as obstacles;
+after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -40,6 +43,11 @@ RETRY_WAIT = 1.0
 REPLAN_PERIOD = 1.0
 #: Progress (m) after which the re-plan count starts again (a long trip may meet many people).
 REPLAN_RESET = 1.5
+#: The local safety layer (:func:`keep_clear`): no velocity toward a sensed point of the static
+#: map (a wall, furniture) within the robot's radius plus this, metres …
+WALL_MARGIN = 0.06
+#: … nor toward any other sensed point (a person's leg) within the radius plus this, metres.
+PERSON_MARGIN = 0.3
 
 
 def _wrap(a: float) -> float:
@@ -147,6 +155,13 @@ class Navigator:
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         static_clear = self.planner.clearance_at(pts)
         return pts[static_clear > STATIC_MARGIN]
+
+    def _static(self, points: np.ndarray | None) -> np.ndarray:
+        """The sensed points that are the static map (walls, furniture)."""
+        if points is None or len(points) == 0:
+            return np.empty((0, 2))
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        return pts[self.planner.clearance_at(pts) <= STATIC_MARGIN]
 
     def _remaining(self, xy: np.ndarray) -> tuple[float, int, np.ndarray]:
         """Distance left along the path, the index of the nearest segment, the projection."""
@@ -282,9 +297,50 @@ class Navigator:
         target_yaw = self.goal.theta if rest < 0.4 else heading
         yaw_err = _wrap(target_yaw - pose.theta)
         wz = float(np.clip(1.5 * yaw_err, -self.max_angular_speed, self.max_angular_speed))
-        vx_map, vy_map = speed * direction / n
+        v_map = keep_clear(
+            speed * direction / n,
+            xy,
+            dynamic,
+            self._static(obstacle_points),
+            self.planner.robot_radius,
+        )
+        vx_map, vy_map = float(v_map[0]), float(v_map[1])
         c, s = math.cos(pose.theta), math.sin(pose.theta)
         return Twist2D(c * vx_map + s * vy_map, -s * vx_map + c * vy_map, wz)
 
 
-__all__ = ["Navigator"]
+def keep_clear(
+    v: np.ndarray,
+    xy: np.ndarray,
+    people: np.ndarray,
+    walls: np.ndarray,
+    radius: float = 0.215,
+) -> np.ndarray:
+    """The map-frame velocity ``v`` without its components toward sensed points too close.
+
+    For every point of ``walls`` within ``radius + WALL_MARGIN`` and of ``people`` within
+    ``radius + PERSON_MARGIN`` of ``xy`` (nearest first), the part of ``v`` along the direction
+    to the point is removed when it points toward it; the rest (sliding along a wall, turning
+    away) is kept. Two passes, so that removing one component does not leave another pointing in.
+    """
+    out = np.asarray(v, dtype=float).copy()
+    groups = [(np.asarray(walls, float).reshape(-1, 2), radius + WALL_MARGIN)]
+    groups.append((np.asarray(people, float).reshape(-1, 2), radius + PERSON_MARGIN))
+    normals = []
+    for pts, reach in groups:
+        if not len(pts):
+            continue
+        rel = pts - xy
+        d = np.linalg.norm(rel, axis=1)
+        close = (d < reach) & (d > 1e-9)
+        order = np.argsort(d[close])
+        normals.extend(rel[close][order] / d[close][order, None])
+    for _ in range(2):
+        for n in normals:
+            toward = float(out @ n)
+            if toward > 0.0:
+                out -= toward * n
+    return out
+
+
+__all__ = ["Navigator", "keep_clear"]

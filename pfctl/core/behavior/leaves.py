@@ -221,7 +221,8 @@ class WaypointSearch(Action):
     target's last path decides l*), re-deciding every ``REPLAN_S`` seconds as the occupancy grid
     fills in. The robot keeps its way-point while that frontier still exists (so it does not
     dither between clusters), and a way-point it has reached or could not reach is not chosen
-    again; when every frontier left has been visited, it turns in place to look and starts
+    again — a frontier still there is followed along to its next unvisited point; when every
+    frontier left has been visited, it turns in place to look and starts
     afresh. RUNNING until the target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing
     at all to search (no region to go to)."""
 
@@ -242,30 +243,65 @@ class WaypointSearch(Action):
     def _decide(self) -> WaypointDecision:
         seen = self.last_seen
         history = seen.history if seen is not None else np.empty((0, 3))
-        decision = self.skills.next_waypoint(history)
+        decision = self._unvisited(self.skills.next_waypoint(history))
         self._decided_at = self.t
         current = self._decision
-        goals = [g for g in decision.goals if self._fresh(g)]
         keep = None
         if current is not None and current.reason == "frontier":
             keep = next(
-                (g for g in goals if math.dist(g, current.waypoint) < self.KEEP_RADIUS), None
+                (
+                    g
+                    for g, u in zip(decision.goals, decision.utilities, strict=True)
+                    if np.isfinite(u) and math.dist(g, current.waypoint) < self.KEEP_RADIUS
+                ),
+                None,
             )
         if keep is not None:
             decision = _with_waypoint(decision, keep)
-        elif decision.reason == "frontier" and not self._fresh(decision.waypoint):
-            ranked = sorted(
-                (i for i, g in enumerate(decision.goals) if self._fresh(g)),
-                key=lambda i: -decision.utilities[i],
-            )
-            if ranked and np.isfinite(decision.utilities[ranked[0]]):
-                decision = _with_waypoint(decision, decision.goals[ranked[0]])
-            elif decision.target_point is not None:
-                decision = replace(
-                    decision, waypoint=decision.target_point, reason="visited_fallback", best=None
-                )
         self._decision = decision
         self.skills.waypoint = decision
+        return decision
+
+    def _unvisited(self, decision: WaypointDecision) -> WaypointDecision:
+        """``decision`` without the places already visited. A cluster whose goal (its point
+        nearest l*) was visited but which is still a frontier — the robot got there and could
+        not see past an obstacle, e.g. round the end of a bookshelf — gets its nearest point
+        that is not near a visited way-point (keeping its utility): the robot follows the
+        frontier along instead of leaving the room. A cluster with no such point is out; with
+        no cluster left, the way-point is l*'s point (``visited_fallback``)."""
+        if decision.reason != "frontier":
+            return decision  # no reachable frontier: Algorithm 1 already goes to l*
+        pose = self.bb.pose
+        anchor = decision.target_point or (pose.x, pose.y)
+        goals: list[tuple[float, float]] = []
+        utilities: list[float] = []
+        for cluster, goal, u in zip(
+            decision.clusters, decision.goals, decision.utilities, strict=True
+        ):
+            if self._fresh(goal):
+                goals.append(goal)
+                utilities.append(u)
+                continue
+            pts = cluster.points
+            far = np.ones(len(pts), dtype=bool)
+            for v in self._visited:
+                far &= np.hypot(pts[:, 0] - v[0], pts[:, 1] - v[1]) >= self.VISITED_RADIUS
+            if far.any():
+                cand = pts[far]
+                i = int(np.argmin(np.hypot(cand[:, 0] - anchor[0], cand[:, 1] - anchor[1])))
+                goals.append((float(cand[i, 0]), float(cand[i, 1])))
+                utilities.append(u)
+            else:
+                goals.append(goal)
+                utilities.append(-math.inf)
+        decision = replace(decision, goals=tuple(goals), utilities=tuple(utilities))
+        ranked = sorted(range(len(goals)), key=lambda i: -utilities[i])  # first on ties
+        if np.isfinite(utilities[ranked[0]]):
+            return _with_waypoint(decision, goals[ranked[0]])
+        if decision.target_point is not None:
+            return replace(
+                decision, waypoint=decision.target_point, reason="visited_fallback", best=None
+            )
         return decision
 
     def act(self) -> Status:
@@ -291,7 +327,7 @@ class WaypointSearch(Action):
 
 
 def _with_waypoint(decision: WaypointDecision, goal: tuple[float, float]) -> WaypointDecision:
-    best = decision.goals.index(goal)
+    best = decision.goals.index(goal)  # the first on equal goals: the higher utility
     return replace(decision, waypoint=goal, best=best, reason="frontier")
 
 
