@@ -229,6 +229,12 @@ def test_fallback_point_avoids_furniture_and_no_heading_uses_the_current_region(
     assert still.reason == "no_frontier_fallback"
     nowhere = waypoint_search(grid, rmap, _walk((20, 20), (20, 20)), (30.0, 30.0), **SEARCH)
     assert nowhere.reason == "no_target" and nowhere.waypoint == (30.0, 30.0)
+    # no history at all (a target never seen): the robot's region, unless that fallback is off
+    empty = np.empty((0, 3))
+    anchored = waypoint_search(grid, rmap, empty, (3.0, 5.0), **SEARCH)
+    assert anchored.target_region == "hall"
+    free = waypoint_search(grid, rmap, empty, (3.0, 5.0), **SEARCH, robot_region_fallback=False)
+    assert free.target_region is None and free.reason == "no_target"
 
 
 def test_waypoint_utilities_are_eq3(rmap: RegionMap) -> None:

@@ -435,6 +435,7 @@ def hide_target(robot: SimRobot, region: str | None) -> str:
         raise UserError(f"--region {region}: no free spot for the target")
     x, y = cells[int(rng.integers(len(cells)))]
     target.hold(float(x), float(y), float(rng.uniform(-math.pi, math.pi)))
+    robot.resense()  # the first observation must not show the target where she stood
     return region
 
 

@@ -296,6 +296,7 @@ def waypoint_search(
     free_thresh: float = FREE_THRESH,
     occupied_thresh: float = OCCUPIED_THRESH,
     confine_to_regions: bool = True,
+    robot_region_fallback: bool = True,
 ) -> WaypointDecision:
     """**Algorithm 1**, way-point search, end to end (§II-B/C/D).
 
@@ -311,6 +312,9 @@ def waypoint_search(
        one from l*, confined to the known map and the two start points grown by
        ``paths.SEARCH_MARGIN`` = 2 m). With
        no l* at all the d(c, l*) term is dropped and c is the point closest to the robot.
+    ``robot_region_fallback`` False drops the last fallback (with no history at all — a target
+    never seen — l* stays None: anchoring the search to the room the robot happens to be in
+    would keep it there).
     With ``confine_to_regions`` (the default), the cells of :meth:`RegionMap.blocked_mask` count
     as obstacles — outside every region, and the walls between regions: the person is somewhere
     in the house, so frontiers outside it are not worth a look; a wall the robot has not seen yet
@@ -327,7 +331,7 @@ def waypoint_search(
     if target is None:
         w = _window(history, window_s)
         target = region_map.locate(w[-1, 1:3]) if len(w) else None
-    if target is None:
+    if target is None and robot_region_fallback:
         target = region_map.locate(robot)
     target_point = region_map.region_point(target) if target is not None else None
 

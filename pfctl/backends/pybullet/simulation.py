@@ -255,6 +255,15 @@ class SimRobot:
             odometry=self.odometry,
         )
 
+    def resense(self) -> None:
+        """Take the laser scan and camera frame again now, e.g. after people were moved by hand
+        (:meth:`Walker.hold`), so that the next :meth:`observe` does not show the scene as it
+        was before."""
+        if self._closed:
+            raise RuntimeError("the simulator is closed")
+        self._next_scan = self._next_frame = self.time
+        self._sense()
+
     def person_instances(self) -> dict[int, int]:
         """Body id → person instance index, for the mask person detector (the simulator's
         stand-in for OpenPose); the index is not the person's name."""

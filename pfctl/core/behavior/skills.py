@@ -273,11 +273,11 @@ class Skills:
     # -- search ---------------------------------------------------------------------------------
 
     def next_waypoint(self, history: ArrayLike) -> WaypointDecision:
-        """Algorithm 1 on the robot's occupancy grid for the target's ``history`` (t, x, y)."""
+        """Algorithm 1 on the robot's occupancy grid for the target's ``history`` (t, x, y).
+        With no history (the target was never seen) l* is None: the frontiers are scored by
+        their size and distance alone (Eq. 3 without the d(c, l*) term)."""
         s = self.search
         h = since_region_entered(np.asarray(history, dtype=float).reshape(-1, 3), self.regions)
-        if len(h) == 0:
-            h = np.array([[self.now, self.pose.x, self.pose.y]])
         return waypoint_search(
             self.grid,
             self.regions,
@@ -288,6 +288,7 @@ class Skills:
             s.frontier_threshold,
             s.min_frontier_cells,
             s.heading_window_s,
+            robot_region_fallback=False,
         )
 
 
