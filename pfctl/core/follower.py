@@ -312,7 +312,8 @@ class Follower:
         )
 
     def close(self) -> None:
-        """Stop the base and drop the blackboard keys; safe to call twice."""
+        """Stop the base, drop the blackboard keys and release the perception (its face
+        worker); safe to call twice."""
         if self._closed:
             return
         self._closed = True
@@ -321,6 +322,7 @@ class Follower:
         finally:
             self.robot.command(STOP)
             clear_namespace(self.namespace)
+            self.perception.close()
 
 
 __all__ = ["Follower", "FollowerParams", "PredictionParams"]
