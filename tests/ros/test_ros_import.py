@@ -1,0 +1,40 @@
+"""The ROS import helper: pfctl never loads rospy unless the HSR backend asks, and a missing ROS 1
+is one clear error. These run without ROS 1 too (fresh interpreters, no master)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+
+
+def _python(code: str, **env: str) -> subprocess.CompletedProcess[str]:
+    full = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"} | env
+    return subprocess.run(
+        [sys.executable, "-c", code], env=full, capture_output=True, text=True, timeout=120
+    )
+
+
+def test_pfctl_without_hsr_backend_never_imports_rospy():
+    done = _python(
+        "import sys; from pfctl import cli; import pfctl.backends.hsr.convert\n"
+        "sys.argv = ['pfctl', '--help']\n"
+        "try:\n    cli.main()\nexcept SystemExit:\n    pass\n"
+        "ros = ('rospy', 'rosgraph', 'genpy', 'sensor_msgs', 'std_msgs')\n"
+        "print('ROS', [m for m in sys.modules if m.split('.')[0] in ros])"
+    )
+    assert done.returncode == 0, done.stderr
+    assert "ROS []" in done.stdout
+
+
+def test_missing_ros_is_one_clear_error():
+    done = _python(
+        "from pfctl.backends.hsr.ros_import import import_ros_module\n"
+        "try:\n    import_ros_module('no_such_ros_pkg.msg')\n"
+        "except Exception as e:\n    print(type(e).__name__, '|', e)\n",
+        PFCTL_ROS_PYTHONPATH="/nonexistent",
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("RosUnavailableError | the HSR backend needs ROS 1")
+    assert "apt-get install --no-install-recommends ros-core python3-rospy" in done.stdout
+    assert len(done.stdout.strip().splitlines()) == 1
