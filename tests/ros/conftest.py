@@ -22,7 +22,7 @@ import subprocess
 import sys
 import time
 import xmlrpc.client
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -194,3 +194,21 @@ def start_node(
 def stop_node(process: subprocess.Popen[str]) -> None:
     """Stop a node process (SIGTERM to its group, then SIGKILL), as for the master."""
     _stop(process)  # type: ignore[arg-type]
+
+
+@pytest.fixture
+def ros_nodes(ros_master: RosMaster) -> Iterator[Callable[..., subprocess.Popen[str]]]:
+    """``start(script, *args, stdin=None)``: a node process on the test's master (see
+    :func:`start_node`); every node started is stopped after the test."""
+    started: list[subprocess.Popen[str]] = []
+
+    def start(script: str, *args: str, stdin: int | None = None) -> subprocess.Popen[str]:
+        process = start_node(ros_master, script, *args, stdin=stdin)
+        started.append(process)
+        return process
+
+    try:
+        yield start
+    finally:
+        for process in started:
+            stop_node(process)
