@@ -145,7 +145,7 @@ def test_keep_clear_slides_along_walls_and_stops_short_of_people() -> None:
     assert np.allclose(keep_clear(v, here, none, wall, r), [0.0, 0.1])  # slides along it
     far_wall = np.array([[r + WALL_MARGIN + 0.05, 0.0]])
     assert np.allclose(keep_clear(v, here, none, far_wall, r), v)
-    leg = np.array([[0.3, 0.3]])  # a person's leg within the radius + PERSON_MARGIN
+    leg = np.array([[0.25, 0.25]])  # a person's leg within the radius + PERSON_MARGIN
     assert np.hypot(*leg[0]) < r + PERSON_MARGIN
     out = keep_clear(v, here, leg, none, r)
     assert out @ (leg[0] / np.linalg.norm(leg[0])) <= 1e-12  # no approach

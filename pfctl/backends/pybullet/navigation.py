@@ -20,6 +20,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy import optimize
 
 from pfctl.core.planning import GridPlanner, NoPathError
 from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
@@ -33,8 +34,9 @@ STATIC_MARGIN = 0.15
 #: No progress of at least PROGRESS metres for this long triggers a re-plan, seconds.
 STUCK_TIME = 4.0
 PROGRESS = 0.1
-#: Radius (m) of the disc each blocking point becomes in the re-planning map.
-BLOCKER_RADIUS = 0.1
+#: Radius (m) of the disc each blocking point becomes in the re-planning map (a little more than
+#: PERSON_MARGIN, so a path around a person is one :func:`keep_clear` lets the base drive).
+BLOCKER_RADIUS = 0.25
 #: Re-plans allowed per goal before ABORTED.
 MAX_REPLANS = 5
 #: Wait (s) after a failed re-plan before trying again (a person may walk away).
@@ -47,7 +49,7 @@ REPLAN_RESET = 1.5
 #: map (a wall, furniture) within the robot's radius plus this, metres …
 WALL_MARGIN = 0.06
 #: … nor toward any other sensed point (a person's leg) within the radius plus this, metres.
-PERSON_MARGIN = 0.3
+PERSON_MARGIN = 0.2
 
 
 def _wrap(a: float) -> float:
@@ -162,6 +164,22 @@ class Navigator:
             return np.empty((0, 2))
         pts = np.asarray(points, dtype=float).reshape(-1, 2)
         return pts[self.planner.clearance_at(pts) <= STATIC_MARGIN]
+
+    def _map_near(self, xy: np.ndarray) -> np.ndarray:
+        """Centres of the static map's obstacle cells within reach of :func:`keep_clear`'s wall
+        margin: the laser does not see everything that touches the base (a door jamb beside it,
+        closer than the laser's minimum range or outside its field of view), the map does."""
+        planner = self.planner
+        geo = planner.geometry
+        reach = planner.robot_radius + WALL_MARGIN + geo.resolution
+        k = math.ceil(reach / geo.resolution)
+        r0, c0 = (int(v) for v in geo.world_to_cell(xy))
+        rs = slice(max(r0 - k, 0), max(min(r0 + k + 1, geo.height), 0))
+        cs = slice(max(c0 - k, 0), max(min(c0 + k + 1, geo.width), 0))
+        rr, cc = np.nonzero(planner.obstacle[rs, cs])
+        if not len(rr):
+            return np.empty((0, 2))
+        return geo.cell_to_world(rr + rs.start, cc + cs.start)
 
     def _remaining(self, xy: np.ndarray) -> tuple[float, int, np.ndarray]:
         """Distance left along the path, the index of the nearest segment, the projection."""
@@ -301,7 +319,7 @@ class Navigator:
             speed * direction / n,
             xy,
             dynamic,
-            self._static(obstacle_points),
+            np.vstack([self._static(obstacle_points), self._map_near(xy)]),
             self.planner.robot_radius,
         )
         vx_map, vy_map = float(v_map[0]), float(v_map[1])
@@ -318,29 +336,30 @@ def keep_clear(
 ) -> np.ndarray:
     """The map-frame velocity ``v`` without its components toward sensed points too close.
 
-    For every point of ``walls`` within ``radius + WALL_MARGIN`` and of ``people`` within
-    ``radius + PERSON_MARGIN`` of ``xy`` (nearest first), the part of ``v`` along the direction
-    to the point is removed when it points toward it; the rest (sliding along a wall, turning
-    away) is kept. Two passes, so that removing one component does not leave another pointing in.
+    Every point of ``walls`` within ``radius + WALL_MARGIN`` and of ``people`` within
+    ``radius + PERSON_MARGIN`` of ``xy`` gives a constraint ``v · n ≤ 0`` (``n`` the unit vector
+    toward it): the result is the velocity nearest ``v`` that approaches none of them — the
+    projection onto that cone, ``v − Nᵀλ`` with ``λ ≥ 0`` from non-negative least squares on the
+    polar cone (Moreau's decomposition). Sliding along a wall or past a door jamb is kept; in a
+    corner that surrounds the base the result is zero.
     """
-    out = np.asarray(v, dtype=float).copy()
-    groups = [(np.asarray(walls, float).reshape(-1, 2), radius + WALL_MARGIN)]
-    groups.append((np.asarray(people, float).reshape(-1, 2), radius + PERSON_MARGIN))
+    v0 = np.asarray(v, dtype=float)
     normals = []
-    for pts, reach in groups:
-        if not len(pts):
-            continue
-        rel = pts - xy
-        d = np.linalg.norm(rel, axis=1)
-        close = (d < reach) & (d > 1e-9)
-        order = np.argsort(d[close])
-        normals.extend(rel[close][order] / d[close][order, None])
-    for _ in range(2):
-        for n in normals:
-            toward = float(out @ n)
-            if toward > 0.0:
-                out -= toward * n
-    return out
+    for pts, reach in (
+        (np.asarray(walls, float).reshape(-1, 2), radius + WALL_MARGIN),
+        (np.asarray(people, float).reshape(-1, 2), radius + PERSON_MARGIN),
+    ):
+        if len(pts):
+            rel = pts - xy
+            d = np.linalg.norm(rel, axis=1)
+            close = (d < reach) & (d > 1e-9)
+            normals.append(rel[close] / d[close, None])
+    n = np.vstack(normals) if normals else np.empty((0, 2))
+    if not len(n) or (n @ v0).max() <= 0.0:
+        return v0.copy()
+    lam, _ = optimize.nnls(n.T, v0)
+    out = v0 - n.T @ lam
+    return np.where(np.abs(out) < 1e-12, 0.0, out)
 
 
 __all__ = ["Navigator", "keep_clear"]
