@@ -159,3 +159,127 @@ def test_params_from_the_mission_by_name() -> None:
     belief = load_mission(ROOT / "missions" / "house.yaml").belief
     params = BeliefParams(**belief.model_dump())
     assert params.prior == belief.prior and params.p_o_given_h == belief.p_o_given_h
+
+
+# -- the fast visibility and peak queries equal their plain definitions ----------------------
+
+
+def _reference_visible_mask(
+    geometry: GridGeometry, fov: FieldOfView, blocked: np.ndarray
+) -> np.ndarray:
+    """The visibility of the module docstring written plainly (the implementation before the
+    rays were cast a chunk at a time and the box cut at the longest free ray): every ray
+    sampled out to the far range, the cells of the whole wedge's box."""
+    from pfctl.core.belief import RAY_STEP, _window
+
+    out = np.zeros(geometry.shape, dtype=bool)
+    window = _window(geometry, fov)
+    if window is None:
+        return out
+    r0, r1, c0, c1, far = window
+    res = geometry.resolution
+    x = geometry.origin[0] + (np.arange(c0, c1) + 0.5) * res - fov.origin.x
+    y = geometry.origin[1] + (np.arange(r0, r1) + 0.5) * res - fov.origin.y
+    dx, dy = x[None, :], y[:, None]
+    dist = np.hypot(dx, dy)
+    bearing = np.arctan2(dy, dx) - fov.origin.theta
+    bearing = (bearing + np.pi) % (2.0 * np.pi) - np.pi
+    half = min(fov.half_angle, math.pi)
+    mask = (dist >= fov.range_min) & (dist <= fov.range_max) & (np.abs(bearing) <= half)
+    step = min(RAY_STEP, res / max(far, res))
+    n_rays = max(2, math.ceil(2.0 * half / step) + 1)
+    ray_step = 2.0 * half / (n_rays - 1)
+    ray_angles = fov.origin.theta - half + ray_step * np.arange(n_rays)
+    s = np.arange(0.0, far + res, res / 2.0)
+    px = fov.origin.x + np.cos(ray_angles)[:, None] * s[None, :]
+    py = fov.origin.y + np.sin(ray_angles)[:, None] * s[None, :]
+    cols = np.floor((px - geometry.origin[0]) / res).astype(np.intp)
+    rows = np.floor((py - geometry.origin[1]) / res).astype(np.intp)
+    inside = (rows >= 0) & (rows < geometry.height) & (cols >= 0) & (cols < geometry.width)
+    hit = ~inside
+    hit[inside] = blocked[rows[inside], cols[inside]]
+    first = np.where(hit.any(axis=1), hit.argmax(axis=1), len(s))
+    free = np.append(s, np.inf)[first]
+    ray = np.clip(np.rint((bearing + half) / ray_step).astype(np.intp), 0, n_rays - 1)
+    mask &= dist < free[ray]
+    mask &= ~blocked[r0:r1, c0:c1]
+    out[r0:r1, c0:c1] = mask
+    return out
+
+
+def test_visibility_equals_the_plain_ray_casting_on_random_poses() -> None:
+    """Chunked rays and the box cut at the longest free ray change nothing: the same cells, in
+    the house (walls, doors, furniture) and in an open room, from random poses (some outside
+    the map or at its edge), for the camera's wedge, narrow and wide ones and all around."""
+    mission = load_mission(ROOT / "missions" / "house.yaml")
+    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
+    rng = np.random.default_rng(4)
+    cases = [(grid.geometry, grid.states() != FREE), (GEO, walled())]
+    for geometry, blocked in cases:
+        belief = HumanBelief(geometry, BeliefParams(), blocked)
+        w, h = geometry.width * geometry.resolution, geometry.height * geometry.resolution
+        for k in range(120):
+            x, y = rng.uniform(-1.0, w + 1.0), rng.uniform(-1.0, h + 1.0)
+            half = [math.radians(29.0), 0.05, 1.5, math.pi][k % 4]
+            far = [8.0, 3.0, 20.0][k % 3]
+            fov = FieldOfView(Pose2D(x, y, rng.uniform(-4.0, 4.0)), half, 0.4, far)
+            want = _reference_visible_mask(geometry, fov, blocked)
+            assert np.array_equal(visible_mask(geometry, fov, blocked), want), (k, fov)
+            before = belief.p.copy()
+            got = belief.update(fov, [], t=float(k))
+            assert np.array_equal(got, want & belief.walkable), (k, fov)
+            assert np.array_equal(belief.p != before, got & (before > belief.params.p_min))
+
+
+def _reference_most_likely(
+    belief: HumanBelief, k: int, min_separation: float
+) -> list[tuple[float, float, float]]:
+    """Greedy over the best ``max(64 k, 1024)`` cells (``k`` without a separation), by belief
+    then by cell index, written plainly."""
+    flat = belief.p.ravel()
+    pool = k if min_separation <= 0 else max(64 * k, 1024)
+    order = np.lexsort((np.arange(flat.size), -flat))[:pool]
+    rows, cols = np.unravel_index(order, belief.p.shape)
+    out: list[tuple[float, float, float]] = []
+    for (x, y), i in zip(belief.geometry.cell_to_world(rows, cols), order, strict=True):
+        if flat[i] <= 0.0 or len(out) == k:
+            break
+        if all(math.hypot(x - a, y - b) >= min_separation for a, b, _ in out):
+            out.append((float(x), float(y), float(flat[i])))
+    return out
+
+
+def test_most_likely_equals_the_plain_greedy_with_ties() -> None:
+    """Belief grids are full of equal values (the prior, p_min, 0): the peaks and their order
+    are those of the plain sorted greedy, equal beliefs taken in cell order."""
+    from pfctl.core.belief import _kth_largest
+
+    rng = np.random.default_rng(5)
+    for trial in range(150):
+        shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
+        geometry = GridGeometry(0.05, shape[1], shape[0], (0.0, 0.0))
+        kind = trial % 3
+        if kind == 0:
+            p = rng.choice([0.0, 0.001, 0.05, 0.3, 0.999], size=shape)
+        elif kind == 1:
+            p = rng.random(shape)
+        else:
+            p = np.round(rng.random(shape), 2) * (rng.random(shape) > 0.3)
+        belief = HumanBelief(geometry, BeliefParams())
+        belief.p = p
+        for k in (1, 3, 8, 40):
+            for separation in (0.0, 0.12, 1.0):
+                want = _reference_most_likely(belief, k, separation)
+                assert belief.most_likely(k, separation) == want, (trial, k, separation)
+        flat = p.ravel()
+        for rank in {1, 2, flat.size // 2 + 1, flat.size}:
+            assert _kth_largest(flat, rank) == np.sort(flat)[::-1][rank - 1]
+    # a grid the size of the house's, mostly at the prior, with a few people seen
+    belief = HumanBelief(GridGeometry(0.05, 260, 200, (-0.5, -0.5)), BeliefParams())
+    belief.p[rng.random(belief.p.shape) < 0.3] = 0.001
+    belief.p[:, :20] = 0.0
+    for x, y in ((2.0, 3.0), (2.4, 3.1), (8.0, 5.0)):
+        rows, cols = belief.geometry.world_to_cell(np.array([x, y]))
+        belief.p[int(rows) - 3 : int(rows) + 4, int(cols) - 3 : int(cols) + 4] = 0.6
+    for k, separation in ((8, 1.0), (3, 0.0), (20, 0.3)):
+        assert belief.most_likely(k, separation) == _reference_most_likely(belief, k, separation)

@@ -24,7 +24,16 @@ locks at 0 or 1 and a person can always be found (or lost) again.
 range, samples at half-cell steps), finds where each ray first meets a blocked cell, and marks a
 cell visible when it lies in the wedge, between ``range_min`` and ``range_max`` (horizontal
 distance from the camera, depth-limited), and nearer than the first blocked cell along its
-nearest ray. Everything is vectorised and confined to the wedge's bounding box.
+nearest ray. Everything is vectorised and confined to the wedge's bounding box, cut to the
+longest free ray (nothing beyond it can be seen). The rays are cast a metre at a time and a ray
+that has met a blocked cell is not cast further (most end at a wall a few metres away); the
+grid's border counts as blocked through a padded copy of ``blocked`` made once per belief. The
+cells are exactly those of casting every ray to the far range over the whole box (tested).
+
+**Peaks.** :meth:`HumanBelief.most_likely` (the gaze's candidates) ranks cells by belief, then
+by cell index, and picks greedily those at least ``min_separation`` apart. The best cells are
+found by counting, not sorting (:func:`_kth_largest`: a belief grid is mostly a few equal
+values, the prior, p_min and 0, on which ``numpy.argpartition`` is slow).
 
 Cells outside ``walkable`` (walls, furniture, outside the house) hold probability 0 and are never
 updated, so the belief's maxima are always places where a person can stand.
@@ -105,9 +114,12 @@ def bayes_update(
     return num / (num + like_not_h * (1.0 - p))
 
 
-def _window(geometry: GridGeometry, fov: FieldOfView) -> tuple[int, int, int, int, float] | None:
-    """Rows ``[r0, r1)`` and columns ``[c0, c1)`` of the grid that hold the wedge, and its
-    effective far range (``range_max`` clipped to the grid); None if the wedge misses the grid."""
+def _window(
+    geometry: GridGeometry, fov: FieldOfView, reach: float = math.inf
+) -> tuple[int, int, int, int, float] | None:
+    """Rows ``[r0, r1)`` and columns ``[c0, c1)`` of the grid that hold the wedge out to
+    ``reach`` (default: its far range), and its effective far range (``range_max`` clipped to
+    the grid and to ``reach``); None if the wedge misses the grid."""
     ox, oy = geometry.origin
     res = geometry.resolution
     x0, y0 = fov.origin.x, fov.origin.y
@@ -117,7 +129,7 @@ def _window(geometry: GridGeometry, fov: FieldOfView) -> tuple[int, int, int, in
         (ox, oy + geometry.height * res),
         (ox + geometry.width * res, oy + geometry.height * res),
     ]
-    far = min(fov.range_max, max(math.dist((x0, y0), c) for c in corners))
+    far = min(fov.range_max, max(math.dist((x0, y0), c) for c in corners), reach)
     if fov.half_angle >= math.pi:
         xs, ys = [x0 - far, x0 + far], [y0 - far, y0 + far]
     else:
@@ -137,42 +149,102 @@ def _window(geometry: GridGeometry, fov: FieldOfView) -> tuple[int, int, int, in
     return r0, r1, c0, c1, far
 
 
+#: Samples per ray cast at once (1 m at 0.05 m cells); rays that hit stop there.
+_RAY_CHUNK = 40
+
+
+def _padded(blocked: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """``blocked`` with a border of blocked cells, flattened: a sample outside the grid, its
+    cell clipped to the border, ends its ray as leaving the grid does."""
+    h, w = blocked.shape
+    out = np.ones((h + 2, w + 2), dtype=bool)
+    out[1:-1, 1:-1] = blocked
+    return out.ravel()
+
+
+def _first_blocked(
+    geometry: GridGeometry,
+    fov: FieldOfView,
+    angles: NDArray[np.float64],
+    s: NDArray[np.float64],
+    padded: NDArray[np.bool_],
+) -> NDArray[np.intp]:
+    """Per ray (``angles`` from the camera), the index into ``s`` (distances along the ray) of
+    the first sample in a blocked cell or outside the grid; ``len(s)`` for none (the occlusion
+    of Eq. 4's visible cells, module docstring).
+
+    The samples are cast ``_RAY_CHUNK`` at a time and a ray that has hit is not cast further:
+    the same samples and the same first hit as casting them all (most rays end at a wall a few
+    metres away)."""
+    res = geometry.resolution
+    ox, oy = geometry.origin
+    h, w = geometry.shape
+    x0, y0 = fov.origin.x, fov.origin.y
+    first = np.full(len(angles), len(s), dtype=np.intp)
+    active = np.arange(len(angles))
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    for start in range(0, len(s), _RAY_CHUNK):
+        chunk = s[None, start : start + _RAY_CHUNK]
+        px = x0 + cos_a[active][:, None] * chunk
+        py = y0 + sin_a[active][:, None] * chunk
+        cols = np.floor((px - ox) / res)
+        rows = np.floor((py - oy) / res)
+        np.clip(cols, -1, w, out=cols)
+        np.clip(rows, -1, h, out=rows)
+        cells = (rows.astype(np.intp) + 1) * (w + 2) + cols.astype(np.intp) + 1
+        hit = padded[cells]
+        ended = hit.any(axis=1)
+        first[active[ended]] = start + hit[ended].argmax(axis=1)
+        active = active[~ended]
+        if not len(active):
+            break
+    return first
+
+
 def _visible_window(
-    geometry: GridGeometry, fov: FieldOfView, blocked: NDArray[np.bool_] | None
+    geometry: GridGeometry,
+    fov: FieldOfView,
+    blocked: NDArray[np.bool_] | None,
+    padded: NDArray[np.bool_] | None = None,
 ) -> tuple[tuple[int, int, int, int], NDArray[np.bool_]] | None:
-    """The visible cells inside the wedge's bounding box: ``((r0, r1, c0, c1), mask)``."""
+    """The visible cells inside the wedge's bounding box, those Eq. 4 updates:
+    ``((r0, r1, c0, c1), mask)``.
+
+    ``padded`` is :func:`_padded` of ``blocked`` (computed when not given). With ``blocked``
+    the box only reaches as far as the longest free ray: no cell beyond it can be seen.
+    """
     window = _window(geometry, fov)
     if window is None:
         return None
-    r0, r1, c0, c1, far = window
+    far = window[4]
     res = geometry.resolution
+    half = min(fov.half_angle, math.pi)
+    if blocked is not None:
+        # Rays across the wedge, sampled every half cell out to the far range.
+        step = min(RAY_STEP, res / max(far, res))
+        n_rays = max(2, math.ceil(2.0 * half / step) + 1)
+        ray_step = 2.0 * half / (n_rays - 1)
+        ray_angles = fov.origin.theta - half + ray_step * np.arange(n_rays)
+        s = np.arange(0.0, far + res, res / 2.0)
+        first = _first_blocked(
+            geometry, fov, ray_angles, s, _padded(blocked) if padded is None else padded
+        )
+        free = np.append(s, np.inf)[first]  # distance to the first blocked sample per ray
+        reach = float(free.max())
+        if reach < far:
+            window = _window(geometry, fov, reach)
+            if window is None:
+                return None
+    r0, r1, c0, c1, _ = window
     x = geometry.origin[0] + (np.arange(c0, c1) + 0.5) * res - fov.origin.x
     y = geometry.origin[1] + (np.arange(r0, r1) + 0.5) * res - fov.origin.y
     dx, dy = x[None, :], y[:, None]
     dist = np.hypot(dx, dy)
     bearing = np.arctan2(dy, dx) - fov.origin.theta
     bearing = (bearing + np.pi) % (2.0 * np.pi) - np.pi
-    half = min(fov.half_angle, math.pi)
     mask = (dist >= fov.range_min) & (dist <= fov.range_max) & (np.abs(bearing) <= half)
     if blocked is None:
         return (r0, r1, c0, c1), mask
-
-    # Rays across the wedge, sampled every half cell out to the far range.
-    step = min(RAY_STEP, res / max(far, res))
-    n_rays = max(2, math.ceil(2.0 * half / step) + 1)
-    ray_step = 2.0 * half / (n_rays - 1)
-    ray_angles = fov.origin.theta - half + ray_step * np.arange(n_rays)
-    s = np.arange(0.0, far + res, res / 2.0)
-    px = fov.origin.x + np.cos(ray_angles)[:, None] * s[None, :]
-    py = fov.origin.y + np.sin(ray_angles)[:, None] * s[None, :]
-    cols = np.floor((px - geometry.origin[0]) / res).astype(np.intp)
-    rows = np.floor((py - geometry.origin[1]) / res).astype(np.intp)
-    inside = (rows >= 0) & (rows < geometry.height) & (cols >= 0) & (cols < geometry.width)
-    hit = ~inside  # leaving the grid ends a ray too
-    hit[inside] = blocked[rows[inside], cols[inside]]
-    first = np.where(hit.any(axis=1), hit.argmax(axis=1), len(s))
-    free = np.append(s, np.inf)[first]  # distance to the first blocked sample per ray
-
     ray = np.rint((bearing + half) / ray_step).astype(np.intp)
     np.clip(ray, 0, n_rays - 1, out=ray)
     mask &= dist < free[ray]
@@ -202,6 +274,57 @@ def _blocked(geometry: GridGeometry, blocked: ArrayLike) -> NDArray[np.bool_]:
     return arr
 
 
+def _top_cells(flat: NDArray[np.float64], pool: int) -> NDArray[np.intp]:
+    """Indices of the ``pool`` largest values of ``flat`` (equal values: the lower index
+    first), ordered by value descending, then index ascending (the candidates of the gaze's
+    belief peaks, §II-E).
+
+    The ``pool``-th largest value v is found by counting, not sorting (:func:`_kth_largest`);
+    the result is then every index above v and the first indices equal to v.
+    """
+    n = flat.size
+    if pool <= 0:
+        return np.zeros(0, dtype=np.intp)
+    if pool >= n:
+        idx = np.arange(n)
+    else:
+        v = _kth_largest(flat, pool)
+        above = np.flatnonzero(flat > v)
+        tied = np.flatnonzero(flat == v)[: pool - above.size]
+        idx = np.concatenate((above, tied))
+    return idx[np.lexsort((idx, -flat[idx]))]
+
+
+def _kth_largest(flat: NDArray[np.float64], k: int) -> float:
+    """The ``k``-th largest value of ``flat`` (1 ≤ k ≤ size, counted with multiplicity).
+
+    A belief grid holds many equal values (the prior, 0, p_min), on which ``numpy.partition``
+    is slow (~2.5 ms for 52 000 cells; this takes ~0.1 ms). For finite values ≥ 0 the IEEE
+    bits read as integers are ordered like the values, so 12 bits at a time, from the top, are
+    ordered buckets: a bincount finds the bucket that holds the k-th value, and the search goes
+    on inside it until its values are all equal (at most six rounds) or few.
+    """
+    values = np.asarray(flat, dtype=np.float64).ravel()
+    lo, hi = float(values.min()), float(values.max())
+    if not (lo >= 0.0 and math.isfinite(hi)):  # NaN fails both
+        return float(np.partition(values, values.size - k)[values.size - k])
+    bits = (values + 0.0).view(np.int64)  # + 0.0: −0.0 becomes 0.0 (sign bit clear)
+    shift = 52
+    while True:
+        if lo == hi:
+            return lo
+        if values.size <= 64:
+            return float(np.partition(values, values.size - k)[values.size - k])
+        keys = (bits >> shift) & 0xFFF  # the same higher bits inside the bucket: ordered
+        from_top = np.cumsum(np.bincount(keys, minlength=4096)[::-1])
+        j = int(np.searchsorted(from_top, k))  # from_top[j] ≥ k > from_top[j − 1]
+        k -= int(from_top[j - 1]) if j else 0
+        inside = keys == 4095 - j
+        values, bits = values[inside], bits[inside]
+        lo, hi = float(values.min()), float(values.max())
+        shift = max(shift - 12, 0)
+
+
 class HumanBelief:
     """The human belief grid of Eq. 4 over a map (Kim et al., §II-E).
 
@@ -229,6 +352,16 @@ class HumanBelief:
             self.walkable = np.ones(geometry.shape, dtype=bool)
         self.p: NDArray[np.float64] = np.where(self.walkable, self.params.prior, 0.0)
         self.time: float | None = None
+        self._padded: tuple[NDArray[np.bool_], NDArray[np.bool_]] | None = None
+
+    def _padded_blocked(self) -> NDArray[np.bool_] | None:
+        """:func:`_padded` of :attr:`blocked`, made once per blocked array (which is not
+        changed in place)."""
+        if self.blocked is None:
+            return None
+        if self._padded is None or self._padded[0] is not self.blocked:
+            self._padded = (self.blocked, _padded(self.blocked))
+        return self._padded[1]
 
     def reset(self) -> None:
         """Back to the prior everywhere (the clock is kept)."""
@@ -264,7 +397,7 @@ class HumanBelief:
             box = (max(0, row - span), min(geo.height, row + span + 1),
                    max(0, col - span), min(geo.width, col + span + 1))  # fmt: skip
             boxes.append(box)
-        got = _visible_window(geo, fov, self.blocked)
+        got = _visible_window(geo, fov, self.blocked, self._padded_blocked())
         windows = [b for b in boxes if b[0] < b[1] and b[2] < b[3]]
         if got is not None:
             windows.append(got[0])
@@ -309,28 +442,37 @@ class HumanBelief:
 
     def most_likely(self, k: int, min_separation: float = 0.0) -> list[tuple[float, float, float]]:
         """Up to ``k`` cells ``(x, y, p)`` by decreasing belief, at least ``min_separation`` m
-        apart (greedy: a cell closer than that to an already chosen one is skipped)."""
+        apart (greedy: a cell closer than that to an already chosen one is skipped).
+
+        The candidates are the ``k`` best cells, or with a separation the best
+        ``max(64 k, 1024)``, in the order of belief and then of cell index (row-major), so equal
+        beliefs are taken top-left first; cells at 0 are never returned. The selection
+        (:func:`_top_cells`) costs a count over the grid, not a sort; the greedy picks are
+        vectorised (one distance pass per pick).
+        """
         if k <= 0:
             return []
         flat = self.p.ravel()
-        pool = max(k, 1) if min_separation <= 0 else min(flat.size, max(64 * k, 1024))
-        pool = min(pool, flat.size)
-        idx = np.argpartition(-flat, pool - 1)[:pool]
-        idx = idx[np.lexsort((idx, -flat[idx]))]  # by belief, then by index: deterministic
+        pool = k if min_separation <= 0 else max(64 * k, 1024)
+        idx = _top_cells(flat, min(pool, flat.size))
+        idx = idx[flat[idx] > 0.0]
         rows, cols = np.unravel_index(idx, self.p.shape)
         centres = self.geometry.cell_to_world(rows, cols)
-        out: list[tuple[float, float, float]] = []
-        for (x, y), i in zip(centres, idx, strict=True):
-            if flat[i] <= 0.0:
-                break
-            if min_separation > 0 and any(
-                math.hypot(x - a, y - b) < min_separation for a, b, _ in out
-            ):
-                continue
-            out.append((float(x), float(y), float(flat[i])))
-            if len(out) == k:
-                break
-        return out
+        if min_separation <= 0:
+            chosen = np.arange(min(k, len(idx)))
+        else:
+            alive = np.ones(len(idx), dtype=bool)
+            picks: list[int] = []
+            while len(picks) < k:
+                left = np.flatnonzero(alive)
+                if not len(left):
+                    break
+                j = int(left[0])
+                picks.append(j)
+                d = np.hypot(centres[:, 0] - centres[j, 0], centres[:, 1] - centres[j, 1])
+                alive &= d >= min_separation
+            chosen = np.array(picks, dtype=np.intp)
+        return [(float(centres[j, 0]), float(centres[j, 1]), float(flat[idx[j]])) for j in chosen]
 
     def at(self, xy: ArrayLike) -> NDArray[np.float64]:
         """The belief at map points ``(..., 2)`` (0 outside the grid)."""
