@@ -121,3 +121,76 @@ def test_make_detector_auto_picks_mask_with_a_mask_else_hog() -> None:
     else:
         with pytest.raises(RuntimeError, match="HOG"):
             make_detector("auto", _frame(depth))
+
+
+def _reference_detect(det: MaskPersonDetector, frame: RgbdFrame) -> list[tuple]:
+    """The mask detector written plainly, one full-image pass per person (as it was before the
+    lookup tables and the one sort): its detections as comparable tuples."""
+    from pfctl.core.vision import _PARTS, _bbox
+
+    assert frame.mask is not None
+    ids = {int(b): i for b, i in det.instances.items()}
+    inst = np.vectorize(lambda b: ids.get(int(b), -1))(frame.mask)
+    part = np.vectorize(lambda b: _PARTS.get(det.parts.get(int(b), ""), 0))(frame.mask)
+    out = []
+    for k in np.unique(inst[inst >= 0]):
+        body = inst == k
+        vs, us = np.nonzero(body)
+        if len(us) < det.min_pixels:
+            continue
+        position = body_position(frame, us, vs)
+        if position is None:
+            continue
+        head_box, kp = None, None
+        if det.parts:
+            pix = {n: np.nonzero(body & (part == c)) for n, c in _PARTS.items()}
+            kp = {}
+            if len(pix["head"][0]):
+                hv, hu = pix["head"]
+                head_box = _bbox(hu, hv)
+                kp["head"] = (float(np.mean(hu)), float(np.mean(hv)))
+            if len(pix["torso"][0]):
+                tv, tu = pix["torso"]
+                kp["neck"] = (float(np.median(tu)), float(tv.min()))
+                kp["mid_hip"] = (float(np.median(tu)), float(tv.max()))
+            if len(pix["leg"][0]):
+                lv, lu = pix["leg"]
+                kp["ankles"] = (float(np.median(lu)), float(lv.max()))
+            kp = kp or None
+        out.append((int(k), _bbox(us, vs), position, head_box, kp, body.tobytes()))
+    return out
+
+
+def test_mask_detector_equals_the_plain_per_person_passes() -> None:
+    """The lookup-table detector finds the same people with the same boxes, positions (bit for
+    bit), keypoints and masks as one pass per person, on random crowded masks: bodies of
+    several instances and parts, furniture ids above and below theirs, -1, missing depth."""
+    rng = np.random.default_rng(11)
+    bodies = {10: 0, 11: 0, 12: 0, 30: 1, 31: 1, 5: 2, 6: 2, 7: 2, 40: 4}
+    parts = {10: "head", 11: "torso", 12: "leg", 30: "head", 31: "torso", 5: "leg", 40: "torso"}
+    found = 0
+    for trial in range(40):
+        mask = np.full((H, W), -1, np.int32)
+        depth = rng.uniform(1.0, 6.0, (H, W))
+        depth[rng.random((H, W)) < 0.1] = np.inf
+        for _ in range(int(rng.integers(0, 12))):
+            u, v = int(rng.integers(0, W - 5)), int(rng.integers(0, H - 5))
+            du, dv = int(rng.integers(3, 50)), int(rng.integers(3, 70))
+            mask[v : v + dv, u : u + du] = rng.choice([*bodies, 0, 3, 99, 1000, 2**30])
+        if trial % 3 == 1:
+            mask = mask.astype(np.int64)
+        elif trial % 3 == 2:
+            mask = np.where(mask < 0, -1, mask % 128).astype(np.int16)
+        frame = _frame(depth, mask)
+        for det in (
+            MaskPersonDetector(bodies, parts, min_pixels=int(rng.integers(1, 200))),
+            MaskPersonDetector(bodies, min_pixels=50),
+        ):
+            got = [
+                (d.instance, d.box, d.position, d.head_box, d.keypoints, d.mask.tobytes())
+                for d in det.detect(frame)
+                if d.mask is not None
+            ]
+            assert got == _reference_detect(det, frame), trial
+            found += len(got)
+    assert found > 100

@@ -137,61 +137,87 @@ class MaskPersonDetector:
         self.parts = dict(parts or {})
         self.min_pixels = int(min_pixels)
         self.names = dict(names or {})
-        ids = np.array(sorted(self.instances), dtype=np.int64)
-        self._ids = ids
-        self._inst = np.array([self.instances[i] for i in ids], dtype=np.int64)
-        self._part = np.array([_PARTS.get(self.parts.get(int(i), ""), 0) for i in ids], np.int8)
+        # Lookup tables indexed by body id: the person (index into ``_people``, -1: no person)
+        # and the part code; ids outside [0, _top) read the last entry (no person).
+        people = sorted(set(self.instances.values()))
+        self._people = np.array(people, dtype=np.int64)
+        self._top = max(self.instances, default=-1) + 1
+        self._person = np.full(self._top + 1, -1, dtype=np.int16)
+        self._part = np.zeros(self._top + 1, dtype=np.int8)
+        for body, instance in self.instances.items():
+            if body < 0:
+                raise ValueError(f"body ids must be ≥ 0, got {body}")
+            self._person[body] = people.index(instance)
+            self._part[body] = _PARTS.get(self.parts.get(body, ""), 0)
 
     def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
-        """One detection per person instance with at least ``min_pixels`` pixels."""
+        """One detection per person instance with at least ``min_pixels`` pixels, by instance
+        (the people OpenPose would give the paper's §II-E).
+
+        One pass over the mask: body id → person and part through lookup tables, a pixel
+        count per person (bincount), and one stable sort of the people's pixels by person, so
+        each person's pixels come out in row-major order, as ``numpy.nonzero`` of its mask
+        would give them.
+        """
         if frame.mask is None:
             raise ValueError("MaskPersonDetector needs a frame with a segmentation mask")
         mask = frame.mask
-        if len(self._ids) == 0:
+        if len(self._people) == 0:
             return []
-        # person instance per pixel (-1: none), through a sorted lookup of body ids
-        flat = mask.ravel().astype(np.int64)
-        pos = np.clip(np.searchsorted(self._ids, flat), 0, len(self._ids) - 1)
-        hit = self._ids[pos] == flat
-        inst = np.where(hit, self._inst[pos], -1).reshape(mask.shape)
-        part = np.where(hit, self._part[pos], 0).reshape(mask.shape)
+        h, w = mask.shape
+        flat = mask.ravel()
+        if flat.dtype.kind not in "iu":
+            flat = flat.astype(np.int64)
+        # negative ids become huge unsigned ones: both end on the "no person" entry
+        code = np.minimum(flat.view(flat.dtype.str.replace("i", "u")), self._top)
+        person = self._person[code]
+        pixels = np.flatnonzero(person >= 0)
+        if not len(pixels):
+            return []
+        who = person[pixels]
+        counts = np.bincount(who, minlength=len(self._people))
+        pixels = pixels[np.argsort(who, kind="stable")]
+        parts = self._part[code[pixels]] if self.parts else None
+        ends = np.cumsum(counts)
         out = []
-        for k in np.unique(inst[inst >= 0]):
-            body = inst == k
-            vs, us = np.nonzero(body)
-            if len(us) < self.min_pixels:
+        for i, instance in enumerate(self._people):
+            if counts[i] < max(self.min_pixels, 1):
                 continue
+            span = slice(int(ends[i] - counts[i]), int(ends[i]))
+            idx = pixels[span]
+            vs, us = np.divmod(idx, w)
             position = body_position(frame, us, vs)
             if position is None:
                 continue
-            box = _bbox(us, vs)
-            head_box, keypoints = self._parts_of(part, body, box)
+            body = np.zeros(h * w, dtype=bool)
+            body[idx] = True
+            head_box, keypoints = (
+                self._parts_of(parts[span], us, vs) if parts is not None else (None, None)
+            )
             out.append(
                 PersonDetection(
-                    box=box,
+                    box=_bbox(us, vs),
                     position=position,
                     score=1.0,
-                    mask=body,
+                    mask=body.reshape(h, w),
                     keypoints=keypoints,
                     head_box=head_box,
-                    instance=int(k),
-                    ground_truth_name=self.names.get(int(k)),
+                    instance=int(instance),
+                    ground_truth_name=self.names.get(int(instance)),
                 )
             )
         return out
 
+    @staticmethod
     def _parts_of(
-        self, part: np.ndarray, body: np.ndarray, box: Box
+        part: np.ndarray, us: np.ndarray, vs: np.ndarray
     ) -> tuple[Box | None, Keypoints | None]:
-        if not self.parts:
-            return None, None
-        x0, y0, x1, y1 = box
-        crop = np.where(body[y0:y1, x0:x1], part[y0:y1, x0:x1], 0)
+        """The head box and keypoints from the part code of each of a person's pixels."""
         pix: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         for name, code in _PARTS.items():
-            vs, us = np.nonzero(crop == code)
-            if len(us):
-                pix[name] = (us + x0, vs + y0)
+            sel = part == code
+            if sel.any():
+                pix[name] = (us[sel], vs[sel])
         keypoints: dict[str, tuple[float, float]] = {}
         head_box = None
         if "head" in pix:
