@@ -201,3 +201,127 @@ def test_tracks_without_legs_are_not_candidates_and_unseen_tracks_keep_their_evi
     legs = ident.observe(7, 0.1, True, None, None)  # legs now; the camera did not see it
     assert legs.decision is Decision.TARGET and legs.face_samples == 1
     assert ident.observe(8, 0.1, True, None, None).decision is Decision.UNKNOWN
+
+
+def test_describe_on_the_box_equals_the_whole_image() -> None:
+    """describe() cuts the image and the body masks to the person's box: the histograms are the
+    ones of the whole-image masks, bit for bit — with a mask, with a mask reaching outside its
+    box (then the whole image is used), without one, and for boxes over the image's edge."""
+    rng = np.random.default_rng(3)
+    params = IdentityParams()
+    h, w = 120, 160
+    for trial in range(60):
+        img = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+        x0, y0 = int(rng.integers(-20, w - 10)), int(rng.integers(-20, h - 10))
+        box = (x0, y0, x0 + int(rng.integers(5, 80)), y0 + int(rng.integers(5, 120)))
+        mask = None
+        if trial % 3:
+            mask = np.zeros((h, w), bool)
+            cut = (slice(max(0, box[1]), max(0, box[3])), slice(max(0, box[0]), max(0, box[2])))
+            mask[cut] = rng.random(mask[cut].shape) < 0.7
+            if trial % 3 == 2:
+                mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True  # maybe outside
+        kp = None
+        if trial % 2:
+            top = box[1] + 0.2 * (box[3] - box[1])
+            kp = {"neck": (0.0, top), "mid_hip": (0.0, top + 0.3 * (box[3] - box[1]))}
+        det = PersonDetection(box, (1.0, 0.0, 1.0), mask=mask, keypoints=kp)
+        upper, lower = body_parts((h, w), box, mask, kp)
+        got = describe(img, det, params)
+        for part, full in ((got.upper, upper), (got.lower, lower)):
+            want = color_histogram(img, full, params.clothes)
+            assert (part is None and want is None) or np.array_equal(part, want), trial
+
+
+def _shirt(upper_rows: tuple[int, int], colours: tuple) -> tuple[np.ndarray, PersonDetection]:
+    """A person without a face: the shirt ``colours`` in horizontal bands, navy trousers."""
+    img = np.full((240, 160, 3), GREY, np.uint8)
+    bands = np.array_split(np.arange(*upper_rows), len(colours))
+    for rows, colour in zip(bands, colours, strict=True):
+        img[rows[0] : rows[-1] + 1, 30:130] = colour
+    img[150:236, 40:120] = NAVY
+    kp = {"neck": (80.0, 80.0), "mid_hip": (80.0, 150.0), "ankles": (80.0, 236.0)}
+    return img, PersonDetection((30, 4, 130, 236), (2.0, 0.0, 1.0), keypoints=kp)
+
+
+def test_settled_clothes_are_measured_less_often_and_decide_the_same() -> None:
+    """Clothes far from the threshold are measured every ``clothes_recheck_s`` once a track has
+    ``clothes_settled`` samples; clothes near it on every frame; the decisions are those of an
+    identifier that measures every frame."""
+    params = IdentityParams(faces=False)
+    red = describe(*_shirt((80, 150), (RED,)), params)
+    profile = learn_profile([red], params)
+    every = TargetIdentifier(profile, IdentityParams(faces=False, clothes_recheck_s=0.0))
+    throttled = TargetIdentifier(profile, params)
+    people = {
+        1: _shirt((80, 150), (RED,)),  # the target's shirt: S ≈ 1
+        2: _shirt((80, 150), (GREEN,)),  # S ≈ 0
+        3: _shirt((80, 150), (RED, GREEN)),  # half of it: S ≈ 0.5, near the threshold 0.6
+    }
+    for k in range(30):
+        t = 0.1 * k
+        for tid, (img, det) in people.items():
+            a = every.observe(tid, t, True, det, img)
+            b = throttled.observe(tid, t, True, det, img)
+            assert (a.decision, a.basis) == (b.decision, b.basis), (k, tid)
+    ids = throttled.identities()
+    assert [ids[i].decision for i in (1, 2)] == [Decision.TARGET, Decision.NOT_TARGET]
+    assert ids[3].clothes_similarity is not None
+    assert abs(ids[3].clothes_similarity - params.clothes_similarity) < params.clothes_margin
+    # 10 samples in the first second, then one every 0.5 s; near the threshold: every frame
+    assert ids[1].clothes_samples == ids[2].clothes_samples == 10 + 4
+    assert ids[3].clothes_samples == 30 and every.identities()[1].clothes_samples == 30
+    assert throttled.face_stats.clothes_skipped == 2 * (30 - 14)
+
+
+def test_a_track_a_face_decides_is_settled_whatever_its_clothes(learned) -> None:
+    """Once a face decides, clothes no longer enter the decision: after ``clothes_settled``
+    samples they are measured only every ``clothes_recheck_s``, even near the threshold."""
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    assert ident.observe(1, 0.0, True, *reversed(_picture(RED, TARGET_FACE))).basis == "face"
+    img, det = _shirt((80, 150), (RED, GREEN))  # the back, in a shirt near the threshold
+    for k in range(1, 15):
+        later = ident.observe(1, 0.1 * k, True, det, img)
+        assert later.decision is Decision.TARGET and later.basis == "face"
+    assert later.clothes_samples == 10 + 1  # frames 0-9, then 1.4 s
+
+
+def _reference_histogram(img: np.ndarray, mask: np.ndarray, params: ClothesParams) -> np.ndarray:
+    """The soft histogram computed pixel by pixel, as written before the lookup tables."""
+    ranges = {"hsv": [0, 180, 0, 256, 0, 256]}.get(params.color_space, [0, 256] * 3)
+    pixels = img[mask].astype(np.float64)
+    parts = [(np.zeros(len(pixels), dtype=np.int64), np.ones(len(pixels)))]
+    for channel, bins in enumerate(params.bins):
+        lo, hi = ranges[2 * channel], ranges[2 * channel + 1]
+        u = (pixels[:, channel] - lo) / (hi - lo) * bins - 0.5
+        k0 = np.floor(u)
+        frac = u - k0
+        k0 = k0.astype(np.int64)
+        k1 = k0 + 1
+        if params.color_space == "hsv" and channel == 0:
+            k0, k1 = k0 % bins, k1 % bins
+        else:
+            k0, k1 = np.clip(k0, 0, bins - 1), np.clip(k1, 0, bins - 1)
+        parts = [
+            (idx * bins + k, w * f) for idx, w in parts for k, f in ((k0, 1.0 - frac), (k1, frac))
+        ]
+    hist = np.zeros(params.size)
+    for idx, w in parts:
+        hist += np.bincount(idx, weights=w, minlength=params.size)
+    return hist / hist.sum()
+
+
+def test_histogram_tables_give_the_per_pixel_histogram_bit_for_bit() -> None:
+    rng = np.random.default_rng(9)
+    for space in ("hsv", "rgb", "lab"):
+        for bins in ((16, 4, 4), (8, 8, 8), (3, 5, 2), (1, 1, 7)):
+            params = ClothesParams(space, bins)  # type: ignore[arg-type]
+            img = rng.integers(0, 256, (60, 70, 3), dtype=np.uint8)
+            if space == "hsv":
+                img[..., 0] %= 180
+            mask = rng.random((60, 70)) < 0.4
+            got = color_histogram(img, mask, params, converted=True)
+            assert np.array_equal(got, _reference_histogram(img, mask, params)), (space, bins)
+    with pytest.raises(ValueError, match="8-bit"):
+        color_histogram(np.zeros((4, 4, 3)), np.ones((4, 4), bool), params, converted=True)

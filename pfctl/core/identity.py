@@ -16,7 +16,17 @@ distances decides.
 Faces are searched only when it is worth it: until a track has ``face_settled`` face samples, then
 every ``face_recheck_s``; and a track whose last ``face_miss_limit`` searches found no face (the
 back of the head, a face turned away) is searched only every ``face_miss_backoff_s`` until one
-is found again. Clothes are measured on every observation (cheap).
+is found again.
+
+Clothes are measured on every observation until the track's clothes evidence is **settled**:
+``clothes_settled`` samples and either a face deciding the track (then clothes no longer enter
+Algorithm 2's decision at all) or a mean similarity at least ``clothes_margin`` away from the
+``clothes_similarity`` threshold. A settled track's clothes are measured again only every
+``clothes_recheck_s`` (a histogram pair costs ~0.5–1 ms per person at 320x240, six people ~5 ms
+a frame; benchmarks/bench_identity.py). The decision is the mean S over the samples; a settled
+track has fewer of them, each weighing more, so new evidence moves its mean about as fast in
+time as before, and a track whose mean comes back within the margin of the threshold is measured
+on every frame again. Which tracks Algorithm 2 names is unchanged on the tests' episodes.
 
 The face search itself (dlib's HOG detector and ResNet embedding, ~75–90 ms per face) runs inline
 by default, or — given a :class:`~pfctl.core.face_worker.FaceWorker` — in a worker process: the
@@ -55,7 +65,7 @@ from pfctl.core.atomic_files import atomic_write
 from pfctl.core.clothes import (
     ClothesParams,
     ColorSpace,
-    body_parts,
+    body_parts_window,
     color_histogram,
     convert,
     histogram_intersection,
@@ -105,6 +115,13 @@ class IdentityParams:
     is searched only every ``face_miss_backoff_s`` until a face is found again."""
     face_miss_backoff_s: float = 0.5
     """How often a track whose face searches keep missing is searched, seconds."""
+    clothes_settled: int = 10
+    """A track with this many clothes samples is settled when a face decides it or its mean
+    similarity is at least ``clothes_margin`` from ``clothes_similarity`` (module docstring)."""
+    clothes_margin: float = 0.15
+    """How far from the threshold a settled track's mean clothes similarity is."""
+    clothes_recheck_s: float = 0.5
+    """How often a settled track's clothes are measured, seconds (0: every observation)."""
     face_timing: FaceTiming = "deterministic"
     """With a face worker: ``deterministic`` (simulator) or ``realtime`` (robot)."""
     face_latency_s: float = 0.1
@@ -165,10 +182,14 @@ def describe(
     face embeds badly). ``converted`` is ``rgb`` already in the clothes'
     colour space (to convert once per frame for several people)."""
     shape = rgb.shape[:2]
-    upper_mask, lower_mask = body_parts(
+    (r0, r1, c0, c1), upper_mask, lower_mask = body_parts_window(
         shape, detection.box, detection.mask, dict(detection.keypoints or {})
     )
-    img = converted if converted is not None else convert(rgb, params.clothes.color_space)
+    # the person's box: the same pixels as the whole image's masks
+    if converted is not None:
+        img = converted[r0:r1, c0:c1]
+    else:
+        img = convert(rgb[r0:r1, c0:c1], params.clothes.color_space)
     upper = color_histogram(img, upper_mask, params.clothes, converted=True)
     lower = color_histogram(img, lower_mask, params.clothes, converted=True)
     face = face_box = None
@@ -372,6 +393,8 @@ class _Evidence:
     """Stamp of the frame of the newest face search (made or submitted)."""
     face_misses: int = 0
     """Face searches in a row that found no face."""
+    last_clothes: float = -math.inf
+    """Stamp of the frame of the newest clothes measurement."""
     face_box: Box | None = None
     face_box_at: float = math.nan
     """When ``face_box`` was folded in: identities made then report it."""
@@ -394,7 +417,7 @@ class _Job:
 
 @dataclass
 class FaceSearchStats:
-    """What the identifier did about faces (counters since it was made)."""
+    """What the identifier did about faces and clothes (counters since it was made)."""
 
     inline: int = 0
     """Searches run inline (no worker)."""
@@ -412,6 +435,10 @@ class FaceSearchStats:
     """Searches skipped because the track's searches kept missing (``face_miss_limit``)."""
     waited_s: float = 0.0
     """Wall time spent waiting for the worker (deterministic timing), seconds."""
+    clothes_measured: int = 0
+    """Clothing histogram pairs measured (one per seen track and frame when due)."""
+    clothes_skipped: int = 0
+    """Clothes measurements skipped because the track was settled (``clothes_recheck_s``)."""
 
 
 class TargetIdentifier:
@@ -511,10 +538,15 @@ class TargetIdentifier:
                 detection = sightings[k][2]
                 if detection is None:
                     continue
+                seen[k] = (track_id, ev, detection)
+                if not self._clothes_due(ev, t):
+                    self.face_stats.clothes_skipped += 1
+                    continue
                 if converted is None:
                     converted = convert(rgb, self.params.clothes.color_space)
                 self._add_clothes(ev, describe(rgb, detection, self.params, None, converted))
-                seen[k] = (track_id, ev, detection)
+                ev.last_clothes = t
+                self.face_stats.clothes_measured += 1
             wanted = [
                 (ev.last_search, k)
                 for k, (_, ev, detection) in enumerate(seen)
@@ -572,6 +604,19 @@ class TargetIdentifier:
         s = self.profile.similarity(appearance)
         if s is not None:
             ev.clothes.append(s)
+
+    def _clothes_due(self, ev: _Evidence, t: float) -> bool:
+        """Whether the track's clothes (Algorithm 2's histogram intersection) should be
+        measured in the frame stamped ``t``: always until its clothes evidence is settled, then
+        every ``clothes_recheck_s`` (module docstring)."""
+        p = self.params
+        if len(ev.clothes) < p.clothes_settled or t - ev.last_clothes >= (
+            p.clothes_recheck_s - STAMP_EPS
+        ):
+            return True
+        if ev.face_distances:  # a face decides; clothes do not enter the decision
+            return False
+        return abs(float(np.mean(ev.clothes)) - p.clothes_similarity) < p.clothes_margin
 
     def _face_due(self, ev: _Evidence, t: float) -> bool:
         """Whether the track's face should be searched in the frame stamped ``t``."""
