@@ -466,3 +466,28 @@ def test_bad_yaml_and_missing_yaml(tmp_path: Path) -> None:
         OccupancyGrid.load_map_server(path)
     with pytest.raises(GridFileError, match="not found"):
         OccupancyGrid.load_map_server(tmp_path / "absent.yaml")
+
+
+def test_crossings_without_padding_equal_the_padded_matrix() -> None:
+    """The grid-line crossings of all beams in one flat array are those of the beams × longest
+    beam matrix whose padding repeats a beam's last line (the set of cells, exactly)."""
+    from pfctl.core.grid import _crossings
+
+    rng = np.random.default_rng(6)
+    for trial in range(50):
+        beams, width = int(rng.integers(1, 300)), int(rng.integers(50, 400))
+        counts = rng.integers(1, [2, 10, 400][trial % 3], beams)
+        first = rng.integers(1, 40, beams).astype(float)
+        slope = rng.uniform(-1.0, 1.0, beams)
+        minor0 = rng.uniform(20.0, 40.0, beams)
+        for along_x in (True, False):
+            got = _crossings(first, slope, minor0, counts, width, along_x)
+            k = np.minimum(
+                np.arange(int(counts.max()), dtype=np.int32)[None, :],
+                (counts - 1).astype(np.int32)[:, None],
+            )
+            minor = (k * slope[:, None] + minor0[:, None]).astype(np.int32)
+            line = k + first.astype(np.int32)[:, None]
+            want = minor * width + line if along_x else line * width + minor
+            assert len(got) == counts.sum()
+            assert set(got.tolist()) == set(want.ravel().tolist()), trial

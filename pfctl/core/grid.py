@@ -180,6 +180,40 @@ class InverseSensorModel:
         return float(logit(self.p_max))
 
 
+def _crossings(
+    first: NDArray[np.float64],
+    slope: NDArray[np.float64],
+    minor0: NDArray[np.float64],
+    counts: NDArray[np.intp],
+    width: int,
+    along_x: bool,
+) -> NDArray[np.int32]:
+    """The cells a scan's beams pass through, for Eq. 1's update: flat cell indices
+    ``row · width + col`` of the grid-line crossings of beams along their major axis (x when
+    ``along_x``). Beam b crosses the lines ``first[b] + k``, k = 0 … counts[b] − 1, at the
+    minor coordinate ``minor0[b] + k · slope[b]``; the cell returned is the one past the line
+    (the caller marks the one before it too).
+
+    All beams' crossings go in one flat array, with no padding to the longest beam. In-place
+    int32 arithmetic; truncation is floor() here since all points are ≥ 0.
+    """
+    beam = np.repeat(np.arange(len(counts)), counts)
+    k = np.arange(len(beam), dtype=np.int32)
+    k -= (np.cumsum(counts) - counts).astype(np.int32)[beam]
+    minor_f = k * slope[beam]
+    minor_f += minor0[beam]
+    minor = minor_f.astype(np.int32)
+    line = k
+    line += first.astype(np.int32)[beam]
+    if along_x:  # line = column i, minor = row: cells (row, i) and (row, i − 1)
+        minor *= width
+        minor += line
+    else:  # line = row j, minor = column: cells (j, col) and (j − 1, col)
+        line *= width
+        minor += line
+    return minor
+
+
 class OccupancyGrid:
     """A probabilistic occupancy grid: the log-odds of p(m) per cell, updated by Eq. 1.
 
@@ -490,23 +524,7 @@ class OccupancyGrid:
             first = lo[keep] + 1.0  # the first grid line crossed
             m = m[keep]
             minor0 = ns[major][keep] + (first - a[keep]) * m  # the minor coordinate there
-            # k-th line of each beam; padding repeats a beam's last line (duplicates are harmless).
-            # In-place int32 arithmetic; truncation is floor() here since all points are ≥ 0.
-            k = np.minimum(
-                np.arange(int(n.max()), dtype=np.int32)[None, :],
-                (n[keep] - 1).astype(np.int32)[:, None],
-            )
-            minor_f = k * m[:, None]
-            minor_f += minor0[:, None]
-            minor = minor_f.astype(np.int32)
-            line = k
-            line += first.astype(np.int32)[:, None]
-            if along_x:  # line = column i, minor = row: cells (row, i) and (row, i − 1)
-                minor *= W
-                minor += line
-            else:  # line = row j, minor = column: cells (j, col) and (j − 1, col)
-                line *= W
-                minor += line
+            minor = _crossings(first, m, minor0, n[keep], W, along_x)
             crossed = np.zeros(H * W, dtype=bool)
             crossed[minor] = True
             c2 = crossed.reshape(H, W)
