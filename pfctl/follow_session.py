@@ -82,13 +82,18 @@ def build_follower(
 ) -> Follower:
     """The mission's follower on ``robot`` with ``perception``."""
     sm = mission.map.sensor_model
+    grid = static_map(mission)
+    regions = RegionMap(mission.layout())
+    # cached per geometry (~10 ms): made here, not in the tick of the first prediction or
+    # Algorithm 1 (both block the region map's walls on this map's grid)
+    regions.blocked_mask(grid.geometry)
     return Follower(
         robot,
         perception,
         mission.behavior.tree.model_dump(exclude_none=True),
         follower_params(mission),
-        static_map=static_map(mission),
-        regions=RegionMap(mission.layout()),
+        static_map=grid,
+        regions=regions,
         sensor_model=InverseSensorModel(sm.p_hit, sm.p_miss, sm.p_min, sm.p_max),
         robot_radius=mission.robot.radius,
         log=log,

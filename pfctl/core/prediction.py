@@ -32,11 +32,18 @@ metres, so ε is a tube half-width in metres. The per-sample weight given to lib
 weight times the sample's share of time, ``w_i · Δt_i / 1 s`` (``Δt_i = numpy.gradient(t)``), so C
 is a penalty *per second of track*: a 3 s history weighs the same at 10 Hz and at 40 Hz instead of
 four times more at 40 Hz.
+
+**Speed.** The SVRs are fitted by libsvm itself (:func:`fit_rbf_svr`), the solver
+``sklearn.svm.SVR`` calls, with the same arguments: the same support vectors, coefficients and
+intercept, bit for bit, without scikit-learn's input validation around it, which costs ~1 ms
+per fit warm and ~5 ms the first time in a process (it looks for dataframe libraries) — more
+than the solver needs for a 3 s track (~0.1 ms). When that internal entry point is missing (another
+scikit-learn), ``SVR`` is used.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 from typing import Any, Literal, Protocol
 
 import numpy as np
@@ -51,9 +58,11 @@ __all__ = [
     "Poly3",
     "PredictionError",
     "Predictor",
+    "RbfSvr",
     "SvrState",
     "SvrTime",
     "Weighting",
+    "fit_rbf_svr",
     "make_model",
     "model_params",
     "recency_weights",
@@ -199,6 +208,78 @@ def svr_sample_weights(t: FloatArray, weights: FloatArray) -> FloatArray:
     return weights * np.gradient(t) if len(t) > 1 else weights.copy()
 
 
+@dataclass(frozen=True)
+class RbfSvr:
+    """A fitted RBF ε-SVR on one input: ``f(s) = Σ αᵢ exp(−γ (s − sᵢ)²) + b`` with the support
+    vectors ``support_vectors_`` (k, 1), dual coefficients ``dual_coef_`` (1, k) and intercept
+    ``intercept_`` (1,), named as in ``sklearn.svm.SVR``."""
+
+    support_vectors_: FloatArray
+    dual_coef_: FloatArray
+    intercept_: FloatArray
+    gamma: float
+    n_iter_: int = field(default=0, compare=False)
+
+    def predict(self, s: ArrayLike) -> FloatArray:
+        """``f`` at inputs ``s`` (m, 1) or (m,)."""
+        x = np.asarray(s, dtype=float).reshape(-1)
+        d = x[:, None] - self.support_vectors_[:, 0][None, :]
+        return np.exp(-self.gamma * d * d) @ self.dual_coef_[0] + self.intercept_[0]
+
+
+def _libsvm() -> Any:
+    """scikit-learn's libsvm binding (internal), or None."""
+    try:
+        from sklearn.svm import _libsvm as libsvm  # the solver SVR.fit calls
+    except ImportError:  # pragma: no cover - another scikit-learn
+        return None
+    return libsvm if hasattr(libsvm, "fit") else None
+
+
+def fit_rbf_svr(
+    s: FloatArray, y: FloatArray, sample_weight: FloatArray, C: float, epsilon: float, gamma: float
+) -> RbfSvr | SVR:
+    """The RBF ε-SVR of §II-E fitted to inputs ``s`` (n, 1) and targets ``y`` (n,) with
+    ``sample_weight`` rescaling C per sample: libsvm called as ``sklearn.svm.SVR(kernel="rbf",
+    C=C, epsilon=epsilon, gamma=gamma).fit(s, y, sample_weight=sample_weight)`` calls it (its
+    defaults: tol 1e-3, shrinking, 200 MB cache, no iteration limit), so the solution is the
+    same; the ``SVR`` itself when the binding is not there or refuses the call."""
+    libsvm = _libsvm()
+    x = np.ascontiguousarray(s, dtype=np.float64).reshape(len(s), -1)
+    if libsvm is not None:
+        try:
+            libsvm.set_verbosity_wrap(0)
+            _, vectors, _, coef, intercept, _, _, status, n_iter = libsvm.fit(
+                x,
+                np.ascontiguousarray(y, dtype=np.float64),
+                svm_type=3,  # epsilon_svr
+                sample_weight=np.ascontiguousarray(sample_weight, dtype=np.float64),
+                class_weight=np.empty(0),
+                kernel="rbf",
+                C=float(C),
+                nu=0.0,
+                probability=False,
+                degree=3,
+                shrinking=True,
+                tol=1e-3,
+                cache_size=200,
+                coef0=0.0,
+                gamma=float(gamma),
+                epsilon=float(epsilon),
+                max_iter=-1,
+                random_seed=0,  # probability estimates only; unused
+            )
+        except (TypeError, ValueError):  # pragma: no cover - another binding's signature
+            pass
+        else:
+            if status == 0 and np.all(np.isfinite(coef)) and np.all(np.isfinite(intercept)):
+                n = int(np.asarray(n_iter).ravel()[0]) if np.size(n_iter) else 0
+                return RbfSvr(vectors, coef, intercept, float(gamma), n)
+    return SVR(kernel="rbf", C=C, epsilon=epsilon, gamma=gamma).fit(
+        x, y, sample_weight=sample_weight
+    )
+
+
 @dataclass
 class SvrTime:
     """The paper's SVR (§II-E): an RBF ``sklearn.svm.SVR`` per coordinate, time as input.
@@ -229,10 +310,7 @@ class SvrTime:
         s = (t - self.t0_)[:, None]
         y = xy - self.p0_
         self.models_ = [
-            SVR(kernel="rbf", C=self.C, epsilon=self.epsilon, gamma=self.gamma).fit(
-                s, y[:, k], sample_weight=w
-            )
-            for k in (0, 1)
+            fit_rbf_svr(s, y[:, k], w, self.C, self.epsilon, self.gamma) for k in (0, 1)
         ]
 
     def fit(self, t: ArrayLike, xy: ArrayLike, weights: ArrayLike | None = None) -> SvrTime:
