@@ -65,6 +65,27 @@ def _wait_gone(pid: int, limit: float = 20.0) -> bool:
 # -- the worker -----------------------------------------------------------------------------------
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_an_idle_child_waits_for_a_sleeping_parent_only() -> None:
+    """The child starts a job once its parent sleeps: a sleeping process is not running, this
+    one (reading the state) is, one that has ended is not; the wait for a sleeper ends."""
+    from pfctl.core.face_worker import _running, wait_while_running
+
+    sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        for _ in range(200):  # until it has started and gone to sleep
+            if not _running(sleeper.pid):
+                break
+            time.sleep(0.05)
+        assert not _running(sleeper.pid)
+        wait_while_running(sleeper.pid, 60.0)  # returns at once (no timing asserted)
+    finally:
+        sleeper.kill()
+        sleeper.wait()
+    assert _running(os.getpid())
+    assert not _running(sleeper.pid)  # reaped: no such process
+
+
 def test_the_worker_finds_the_same_faces_as_the_inline_encoder(worker: FaceWorker) -> None:
     img = astronaut()
     encoder = FaceEncoder(FaceParams())

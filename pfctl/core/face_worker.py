@@ -11,6 +11,12 @@ and holds the GIL, and the HOG detector a few milliseconds per head, so run inli
 - it lowers its own priority (``os.nice``, and Linux's ``SCHED_IDLE`` policy when ``idle``), so on
   one core the control loop preempts it at once and it runs in the loop's idle time; ``cpus``
   pins it (as a benchmark pins the loop);
+- with ``idle``, a job that arrives while the parent is running (the loop submits mid-tick) is
+  started only once the parent sleeps (Linux: its state in ``/proc``, looked at every
+  millisecond, for at most :data:`PARENT_BUSY_WAIT_S`). SCHED_IDLE alone does not keep a freshly
+  woken child off the CPU: at a scheduler tick it may be given a slice of the loop's tick
+  (measured on Linux 6.18, HZ 250, one core: ticks that submitted a crop took ~4 ms longer in
+  wall time than in CPU time; benchmarks/bench_follower.py);
 - only the **head crop** crosses the process boundary (the region of the frame to search, a few
   KB), never the frame; the boxes come back in the frame's pixels, and the embeddings are the
   ones the inline encoder gives for the same region (same code, same models);
@@ -55,6 +61,8 @@ from pfctl.core.faces import Box, Face, FaceEncoder, FaceParams
 
 #: How often (s) an idle child checks that its parent is still there.
 PARENT_CHECK_S = 0.5
+#: At most this long (s) an ``idle`` child waits for its running parent to sleep before a job.
+PARENT_BUSY_WAIT_S = 0.1
 #: Capacity asked for the jobs pipe (Linux ``F_SETPIPE_SZ``): room for a few head crops, so
 #: :meth:`FaceWorker.submit` never waits for the child to read.
 PIPE_BYTES = 1 << 20
@@ -131,6 +139,26 @@ def _lower_priority(nice: int, idle: bool, cpus: tuple[int, ...] | None) -> None
             os.sched_setaffinity(0, set(cpus))
 
 
+def _running(pid: int) -> bool:
+    """Whether process ``pid`` is running or runnable (Linux ``/proc/<pid>/stat`` state R);
+    False when that cannot be read (not Linux, gone)."""
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as f:
+            stat = f.read()
+    except OSError:
+        return False
+    end = stat.rfind(b")")  # the command name may hold spaces and parentheses
+    return stat[end + 2 : end + 3] == b"R"
+
+
+def wait_while_running(pid: int, limit_s: float, poll_s: float = 0.001) -> None:
+    """Return once process ``pid`` is not running (it sleeps, e.g. between control ticks), or
+    after ``limit_s`` seconds."""
+    deadline = time.monotonic() + limit_s
+    while _running(pid) and time.monotonic() < deadline:
+        time.sleep(poll_s)
+
+
 def _serve(
     params: FaceParams,
     jobs: Connection,
@@ -165,6 +193,8 @@ def _serve(
         if msg is None:
             return
         job, crop, offset, scaled = msg
+        if idle and parent is not None and parent.pid is not None:
+            wait_while_running(parent.pid, PARENT_BUSY_WAIT_S)
         w0, c0 = time.perf_counter(), time.process_time()
         try:
             h, w = crop.shape[:2]
