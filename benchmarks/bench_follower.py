@@ -22,7 +22,10 @@ for a result that is due); ``--no-pace`` runs as fast as it can.
 It reports the median, 90th and 99th percentile and maximum wall time of one follower tick
 (:attr:`EpisodeResult.tick_seconds`: observe → perceive → map → behavior tree → act → log; the
 simulator's step, camera rendering and MOVE_BASE's path planning included, is not in it: a real
-robot renders nothing and its move_base plans in its own process). Goal: p99 under 20 ms. The
+robot renders nothing and its move_base plans in its own process). Goal: p99 under 20 ms. It
+also reports each tick's CPU time in the loop's thread (``time.thread_time``): the tick's own
+work, without the time the OS gave other processes (other jobs on a shared machine, the face
+worker) meanwhile — the figure to compare code changes by when the machine is busy. The
 ticks are also split by what the observation carried (an RGB-D frame or not, read by a thin proxy
 around the robot's ``observe``; with the camera at the tick rate, as in the shipped missions,
 every tick has one) and by whether the tick did face work (inline: a face was embedded; with the
@@ -32,7 +35,8 @@ detection, Algorithm 2 identification, face detection and embedding with dlib wh
 worker's submit and poll, tracking, belief update, occupancy grid update, behavior tree,
 Algorithm 1, prediction, gaze, calls into the robot, Python's garbage collector): per stage how
 many ticks ran it, its median and p99 when it ran, and its mean share of the slowest 1 % of
-ticks. The ten slowest ticks are listed with what they did. With the worker it also prints its
+ticks. The ten slowest ticks are listed with their CPU time, the people in the frame, the
+clothing histograms measured and what they did. With the worker it also prints its
 jobs (submitted, completed, refused because two were out, results folded in or discarded because
 the track was gone, searches backed off on the back of a head) and the child's wall and CPU time
 per job, and the simulator's step time and how often the loop overran its period.
@@ -136,6 +140,15 @@ class TickClock:
         self.embedded = 0
         """Face work in the running tick: faces embedded inline, or crops submitted."""
         self.embeddings: list[int] = []
+        self.cpu: list[float] = []
+        """CPU time of each tick in this thread (``time.thread_time``), s: the tick's own work,
+        without the time the OS gave other processes meanwhile."""
+        self.people: list[int] = []
+        """People the camera detected in each tick's frame."""
+        self.clothes: list[int] = []
+        """Clothing histogram pairs Algorithm 2 measured in each tick."""
+        self.cpu_start = 0.0
+        self.clothes_before = 0
         self.tick_start = 0.0
         self.tick_end = 0.0
         self.steps: list[float] = []
@@ -200,6 +213,8 @@ def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> 
             clock.current = {}
             clock.embedded = 0
             clock.in_tick = True
+            clock.clothes_before = _clothes_measured(self)
+            clock.cpu_start = time.thread_time()
             clock.tick_start = time.perf_counter()
         if profiler is not None:
             profiler.enable()
@@ -211,8 +226,11 @@ def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> 
             if clock is not None:
                 clock.in_tick = False
                 clock.tick_end = time.perf_counter()
+                clock.cpu.append(time.thread_time() - clock.cpu_start)
                 clock.ticks.append(clock.current)
                 clock.embeddings.append(clock.embedded)
+                clock.people.append(len(self.perception.last_sightings))
+                clock.clothes.append(_clothes_measured(self) - clock.clothes_before)
 
     patch(Follower, "tick", timed_tick)
     if clock is not None:
@@ -236,6 +254,13 @@ def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> 
             gc.callbacks.remove(clock.gc_callback)
         for owner, name, value in reversed(undo):
             setattr(owner, name, value)
+
+
+def _clothes_measured(follower: Any) -> int:
+    """Clothing histogram pairs the follower's identifier has measured so far."""
+    identifier = follower.perception.identifier
+    stats = getattr(identifier, "face_stats", None)
+    return int(getattr(stats, "clothes_measured", 0))
 
 
 def _count_embeddings(clock: TickClock, patch: Callable[[Any, str, Any], None]) -> None:
@@ -445,6 +470,8 @@ def report(
         f"{mission.behavior.tick_hz:g} Hz in {result.wall_time:.1f} s wall; {mode.describe()}"
     )
     print(f"  all ticks        {_pcts(ms)}   → p99 {verdict} the goal < {GOAL_MS:g} ms")
+    if len(clock.cpu) == n:
+        print(f"  CPU of the tick  {_pcts(1000.0 * np.asarray(clock.cpu))}   (thread time)")
     if not ok:
         print("  (the per-tick probes do not line up with the ticks; no breakdown)")
         return
@@ -455,6 +482,10 @@ def report(
     work = "a face embedding" if worker is None else "a face crop submitted"
     print(f"  with {work:25s} {_pcts(ms[embedded])}")
     print(f"  without {work:22s} {_pcts(ms[~embedded])}")
+    if len(clock.cpu) == n:
+        cpu = 1000.0 * np.asarray(clock.cpu)
+        print(f"    CPU with    {_pcts(cpu[embedded])}")
+        print(f"    CPU without {_pcts(cpu[~embedded])}")
     print(
         f"  first tick {ms[0]:.1f} ms; p99 without the first second "
         f"{_first_second_p99(ms, mission)}"
@@ -494,15 +525,21 @@ def report(
     if clock.missing:
         print(f"  (not timed, not found in this code: {', '.join(clock.missing)})")
 
-    print("\n  the 10 slowest ticks")
+    print("\n  the 10 slowest ticks (Np: people in the frame, Nc: clothes measured)")
     records = result.log.ticks
     for i in np.argsort(ms)[::-1][:10]:
         parts = sorted(((v, k.strip()) for k, v in clock.ticks[i].items()), reverse=True)[:3]
         rec = records[i] if i < len(records) else None
         what = f"{rec.awareness}/{rec.action}" if rec is not None else "?"
+        who = (
+            f"{clock.people[i]}p {clock.clothes[i]}c"
+            if len(clock.people) == n and len(clock.clothes) == n
+            else ""
+        )
+        cpu = f"cpu {1000 * clock.cpu[i]:5.1f}" if len(clock.cpu) == n else ""
         print(
-            f"  t={rec.t if rec else float('nan'):6.1f} s {ms[i]:7.1f} ms "
-            f"{'frame' if frames[i] else '     '} {what:34s} "
+            f"  t={rec.t if rec else float('nan'):6.1f} s {ms[i]:7.1f} ms {cpu} "
+            f"{'frame' if frames[i] else '     '} {who:6s} {what:34s} "
             + ", ".join(f"{k} {1000 * v:.1f}" for v, k in parts)
         )
     _report_faces(clock, worker)
