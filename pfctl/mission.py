@@ -997,6 +997,70 @@ class ScenarioConfig(_Model):
 # --------------------------------------------------------------------------------------------
 
 
+# --------------------------------------------------------------------------------------------
+# backend
+# --------------------------------------------------------------------------------------------
+
+Topic = Annotated[str, Field(pattern=r"^/[A-Za-z0-9_/]*[A-Za-z0-9_]$")]
+"""A global ROS 1 graph name (``/hsrb/base_scan``)."""
+Frame = Annotated[str, Field(pattern=r"^[A-Za-z0-9_][A-Za-z0-9_/]*$")]
+"""A tf frame id without a leading slash (``base_footprint``)."""
+
+
+class HsrConfig(_Model):
+    """The Toyota HSR over ROS 1 (``--backend hsr``): the topics, frames and safety timeouts.
+
+    The defaults are the names of Toyota's ROS 1 stack; ``pfctl sim serve-hsr`` serves exactly
+    these, so the same mission drives the robot and the simulated house. Person detections come
+    from ``person_labels`` (an instance-segmentation image published by a person detector, e.g. an
+    OpenPose node on another machine, or the simulator): ``sensor_msgs/Image``, encoding ``16UC1``
+    (``mono16``), the RGB image's size and stamp; pixel value 0 is no person, value ``v > 0`` is
+    person ``(v - 1) // 4`` (an index that only has to be stable within one image) and body part
+    ``(v - 1) % 4`` (0 unknown, 1 head, 2 torso, 3 leg).
+    """
+
+    laser: Topic = "/hsrb/base_scan"
+    """sensor_msgs/LaserScan of the base laser (REP-117 ranges)."""
+    rgb: Topic = "/hsrb/head_rgbd_sensor/rgb/image_rect_color"
+    """sensor_msgs/Image, rgb8 or bgr8."""
+    depth: Topic = "/hsrb/head_rgbd_sensor/depth_registered/image_rect_raw"
+    """sensor_msgs/Image registered to the RGB image: 16UC1 (mm) or 32FC1 (m)."""
+    camera_info: Topic = "/hsrb/head_rgbd_sensor/rgb/camera_info"
+    """sensor_msgs/CameraInfo of the RGB image."""
+    person_labels: Topic | None = "/pfctl/person_labels"
+    """sensor_msgs/Image 16UC1 person/part labels (see above); null: no camera detections."""
+    joint_states: Topic = "/hsrb/joint_states"
+    """sensor_msgs/JointState with head_pan_joint and head_tilt_joint."""
+    odom: Topic = "/hsrb/odom"
+    """nav_msgs/Odometry of the base."""
+    pose: Topic | None = None
+    """geometry_msgs/PoseStamped of the base in the map (e.g. ``/global_pose``); null: tf."""
+    command_velocity: Topic = "/hsrb/command_velocity"
+    """geometry_msgs/Twist to the omnidirectional base."""
+    head_command: Topic = "/hsrb/head_trajectory_controller/command"
+    """trajectory_msgs/JointTrajectory to the head."""
+    move_base: Topic = "/move_base/move"
+    """The move_base_msgs/MoveBaseAction server."""
+    viewpoint_stop: Topic | None = "/viewpoint_controller/stop"
+    """std_srvs/Empty called (when it exists) before the head is commanded; null: never."""
+    ground_truth: Topic | None = "/ground_truth"
+    """Namespace of the simulator's truth (``robot``, ``people``, ``collisions``) used for the
+    metrics only, never by the follower; absent on a real robot."""
+    map_frame: Frame = "map"
+    odom_frame: Frame = "odom"
+    base_frame: Frame = "base_footprint"
+    stale_timeout: Positive = 0.5
+    """Zero velocity is published when the laser or the pose is older than this (wall) time, s."""
+    connect_timeout: Positive = 20.0
+    """How long to wait at start for the first laser scan, pose and clock, s."""
+
+
+class BackendConfig(_Model):
+    """Backend-specific settings."""
+
+    hsr: HsrConfig = HsrConfig()
+
+
 class Mission(_Model):
     """A whole mission file. Only ``name`` and ``map.regions`` are required."""
 
@@ -1013,6 +1077,7 @@ class Mission(_Model):
     control: ControlConfig = ControlConfig()
     behavior: BehaviorConfig = BehaviorConfig()
     scenario: ScenarioConfig = ScenarioConfig()
+    backend: BackendConfig = BackendConfig()
 
     @model_validator(mode="after")
     def _places_exist(self) -> Mission:

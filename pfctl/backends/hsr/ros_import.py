@@ -27,7 +27,7 @@ APT_INSTALL = (
     "python3-std-msgs python3-sensor-msgs python3-geometry-msgs python3-nav-msgs "
     "python3-trajectory-msgs python3-rosgraph-msgs python3-tf2-ros python3-tf2-msgs "
     "python3-actionlib python3-actionlib-msgs python3-move-base-msgs python3-std-srvs "
-    "python3-rosbag"
+    "python3-rosbag python3-visualization-msgs"
 )
 """The apt line that installs ROS 1 for the HSR backend (the same list as ``.ci/run``)."""
 
