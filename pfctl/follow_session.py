@@ -19,7 +19,7 @@ from pfctl.core.follower import Follower, FollowerParams, PredictionParams
 from pfctl.core.grid import InverseSensorModel, OccupancyGrid
 from pfctl.core.perception import Perception
 from pfctl.core.regions import RegionMap
-from pfctl.core.robot import STOP, GroundTruth, Robot
+from pfctl.core.robot import STOP, GroundTruth, Robot, RobotLostError
 from pfctl.core.walls import rasterize_house
 from pfctl.mission import Mission
 
@@ -112,6 +112,8 @@ class EpisodeResult:
     """``until`` ended the run before ``duration``."""
     tick_seconds: list[float] = field(default_factory=list)
     """Wall time of each follower tick (not the robot's step), seconds."""
+    lost: str | None = None
+    """Why the run ended early because the robot stopped answering (:class:`RobotLostError`)."""
 
 
 def run_follower(
@@ -127,7 +129,9 @@ def run_follower(
 ) -> EpisodeResult:
     """Tick ``follower`` and step ``robot`` until ``now()`` reaches ``duration`` (or ``until``
     says so after a tick, or ``stop`` asks to end). ``truth`` (simulator) is recorded beside each
-    tick for the metrics. The follower is closed (base stopped) at the end."""
+    tick for the metrics. A robot that stops answering (:class:`RobotLostError`) ends the run
+    with :attr:`EpisodeResult.lost` set, keeping what was measured. The follower is closed (base
+    stopped) at the end."""
     import time
 
     result = EpisodeResult(follower.log)
@@ -150,6 +154,8 @@ def run_follower(
                 on_tick(now())
     except KeyboardInterrupt:
         result.interrupted = True
+    except RobotLostError as err:
+        result.lost = str(err)
     finally:
         follower.close()
         robot.command(STOP)

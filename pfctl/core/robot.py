@@ -227,6 +227,11 @@ class NavStatus(enum.Enum):
     """No goal has been given yet."""
 
 
+class RobotLostError(RuntimeError):
+    """The robot stopped answering mid-run (its sensors went stale, its ROS master or simulator
+    went away). The backend has already stopped the base; the message says what was lost."""
+
+
 @runtime_checkable
 class Robot(Protocol):
     """The port every backend implements (DESIGN.md, "The Robot port")."""
