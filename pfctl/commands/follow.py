@@ -13,6 +13,15 @@ and writes ``trajectory.png`` (Fig. 4), ``timeline.png`` (Fig. 6) and ``metrics.
 it identifies them or ``--duration`` runs out; prints the time to find and the path length,
 writes ``search.png`` and ``metrics.json``.
 
+``--backend hsr`` runs the same follower on a Toyota HSR over ROS 1
+(:mod:`pfctl.backends.hsr.robot`, topics from the mission's ``backend.hsr``) — or on the simulated
+house served as one by ``pfctl sim serve-hsr`` — for ``--duration`` seconds of ROS time, with a
+target profile learned before (``--target``). When the simulator's truth is on the master the
+metrics use it; on a real robot identity switches and collisions cannot be known and the
+distances are the robot's own beliefs (:mod:`pfctl.core.episode_metrics`). A robot that stops
+answering (stale laser or pose, lost master) has its base stopped and ends the run: the outputs of
+what was measured are written and the command exits 1 with one line saying what was lost.
+
 Both stop the base on every exit; the first Ctrl-C ends the episode and keeps what was measured.
 """
 
@@ -24,7 +33,7 @@ import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 import numpy as np
 import typer
@@ -44,9 +53,11 @@ from pfctl.core.episode_metrics import (
 from pfctl.core.face_worker import FaceWorker, FaceWorkerError
 from pfctl.core.grid import FREE
 from pfctl.core.identity import FaceTiming, TargetProfile, learn_profile
-from pfctl.core.robot import Observation, Robot
+from pfctl.core.robot import GroundTruth, Observation, Robot
+from pfctl.core.vision import PersonDetector
 from pfctl.errors import UserError
-from pfctl.follow_session import EpisodeResult, build_follower, run_follower
+from pfctl.follow_session import EpisodeResult, build_follower, run_follower, static_map
+from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import build_perception, identity_params
 
@@ -54,21 +65,37 @@ if TYPE_CHECKING:
     from pfctl.backends.pybullet.recording import EpisodeRecorder
     from pfctl.backends.pybullet.simulation import SimRobot
 
-BACKENDS = ("sim",)
+BACKENDS = ("sim", "hsr")
 #: Simulated seconds the robot watches the target posing when it learns them first.
 LEARN_SECONDS = 6.0
 
 
-def _check_common(backend: str, duration: float, out: Path) -> None:
+def _check_common(
+    backend: str,
+    duration: float,
+    out: Path,
+    target: Path | None,
+    record: Path | None,
+    gui: bool,
+) -> None:
     if backend not in BACKENDS:
-        raise UserError(
-            f"--backend {backend}: expected one of {', '.join(BACKENDS)} "
-            "(the HSR backend is issue 7)"
-        )
+        raise UserError(f"--backend {backend}: expected one of {', '.join(BACKENDS)}")
     if not (math.isfinite(duration) and duration > 0):
         raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: exists and is not a directory")
+    if backend == "hsr":
+        if target is None:
+            raise UserError(
+                "--target: with --backend hsr, give the profile learned on the robot first "
+                "(pfctl learn-target MISSION --backend hsr --out target.npz)"
+            )
+        if record is not None:
+            raise UserError(
+                "--record: only with --backend sim (on ROS, record the topics with rosbag record)"
+            )
+        if gui:
+            raise UserError("--gui: only with --backend sim")
 
 
 def _profile(
@@ -154,23 +181,62 @@ def run_sim_episode(
         robot.people_bodies.parts(),
         min_pixels=mission.perception.vision.min_pixels,
     )
+    port: Robot = robot if recorder is None else RecordingRobot(robot, recorder)  # type: ignore[assignment]
+    return run_episode(
+        mission,
+        port,
+        profile,
+        duration,
+        detector=detector,
+        now=lambda: robot.time,
+        truth=robot.ground_truth,
+        kind="sim",
+        on_tick=on_tick,
+        stop=stop,
+        until_found=until_found,
+        face_worker=face_worker,
+        face_timing=face_timing,
+    )
+
+
+def run_episode(
+    mission: Mission,
+    robot: Robot,
+    profile: TargetProfile,
+    duration: float,
+    *,
+    detector: PersonDetector | None,
+    now: Callable[[], float],
+    truth: Callable[[], GroundTruth] | None,
+    kind: Literal["sim", "real"],
+    on_tick: Callable[[float], None] | None = None,
+    stop: Callable[[], bool] | None = None,
+    until_found: bool = False,
+    face_worker: bool | FaceWorker | None = None,
+    face_timing: FaceTiming | None = None,
+) -> EpisodeResult:
+    """The mission's follower on any ``robot`` (the Robot port) for ``duration`` s of ``now()``:
+    perception with the camera ``detector`` and the human belief over the mission's static map,
+    the target ``profile`` identified by Algorithm 2 (faces in a worker process as
+    :func:`run_sim_episode` says; ``kind`` picks the mission's face timing for a simulated or a
+    real robot), ``truth`` (a simulator's) recorded beside each tick for the metrics."""
+    grid = static_map(mission)
     use_worker = mission.perception.identity.face_worker if face_worker is None else face_worker
     perception = build_perception(
         mission,
         detector=detector,
         profile=profile,
-        belief_grid=(robot.static_map.geometry, robot.static_map.states() != FREE),
+        belief_grid=(grid.geometry, grid.states() != FREE),
         face_worker=use_worker,
         face_timing=face_timing,
-        robot="sim",
+        robot=kind,
     )
     try:
         identifier = perception.identifier
         if identifier is not None and identifier.worker is not None:
             identifier.worker.wait_ready()
         log = EpisodeLog(target_name=mission.scenario.target)
-        port: Robot = robot if recorder is None else RecordingRobot(robot, recorder)  # type: ignore[assignment]
-        follower = build_follower(mission, port, perception, log)
+        follower = build_follower(mission, robot, perception, log)
         params = _metric_params(mission)
 
         def found(record: TickRecord) -> bool:
@@ -180,8 +246,8 @@ def run_sim_episode(
             follower,
             robot,
             duration,
-            now=lambda: robot.time,
-            truth=robot.ground_truth,
+            now=now,
+            truth=truth,
             on_tick=on_tick,
             stop=stop,
             until=found if until_found else None,
@@ -200,11 +266,11 @@ def _worker_errors() -> Iterator[None]:
         raise typer.Exit(1) from None
 
 
-def _progress(console: Console, duration: float) -> Progress:
+def _progress(console: Console, duration: float, unit: str = "s simulated") -> Progress:
     return Progress(
         TextColumn("{task.description}"),
         BarColumn(),
-        TextColumn("{task.completed:.1f}/{task.total:.0f} s simulated"),
+        TextColumn("{task.completed:.1f}/{task.total:.0f} " + unit),
         TimeRemainingColumn(),
         console=console,
         transient=True,
@@ -232,15 +298,21 @@ def _metric_params(mission: Mission) -> MetricParams:
 
 def follow(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
-    backend: Annotated[str, typer.Option("--backend", help="Where to run: sim.")] = "sim",
+    backend: Annotated[
+        str, typer.Option("--backend", help="Where to run: sim (PyBullet) or hsr (ROS 1).")
+    ] = "sim",
     target: Annotated[
         Path | None,
-        typer.Option("--target", help="A target profile (pfctl learn-target); default: learn."),
+        typer.Option(
+            "--target", help="A target profile (pfctl learn-target); default (sim): learn."
+        ),
     ] = None,
     seed: Annotated[
         int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
     ] = None,
-    duration: Annotated[float, typer.Option("--duration", help="Simulated seconds.")] = 120.0,
+    duration: Annotated[
+        float, typer.Option("--duration", help="Seconds (simulated, or ROS time on hsr).")
+    ] = 120.0,
     out: Annotated[
         Path, typer.Option("--out", help="Folder for trajectory.png, timeline.png, metrics.json.")
     ] = Path("out/follow"),
@@ -251,45 +323,90 @@ def follow(
     gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
 ) -> None:
     """Follow the mission's target; lose, predict, search, re-identify and follow again."""
-    from pfctl.backends.pybullet.runner import graceful_interrupts
     from pfctl.follow_plots import timeline_figure, trajectory_figure
     from pfctl.prediction_plots import png_bytes
 
-    _check_common(backend, duration, out)
+    _check_common(backend, duration, out, target, record, gui)
     loaded = load_mission(mission)
     console = Console(stderr=True)
     profile = _profile(loaded, target, seed, console, str(mission))
-    robot = _sim_robot(loaded, seed, gui, str(mission))
-    with robot, _worker_errors():
-        recorder = _recorder(record, loaded)
-        try:
-            with graceful_interrupts() as stop, _progress(console, duration) as bar:
-                task = bar.add_task("following", total=duration)
-                result = run_sim_episode(
-                    loaded,
-                    robot,
-                    profile,
-                    duration,
-                    on_tick=lambda t: bar.update(task, completed=min(t, duration)),
-                    stop=stop,
-                    recorder=recorder,
-                )
-            if recorder is not None:
-                recorder.close()
-        except BaseException:
-            if recorder is not None:
-                recorder.abort()
-            raise
+    if backend == "hsr":
+        result, seed_used = _run_hsr(loaded, profile, duration, console, "following"), None
+    else:
+        robot = _sim_robot(loaded, seed, gui, str(mission))
+        seed_used = robot.seed
+        with robot, _worker_errors():
+            recorder = _recorder(record, loaded)
+            try:
+                with graceful_interrupts() as stop, _progress(console, duration) as bar:
+                    task = bar.add_task("following", total=duration)
+                    result = run_sim_episode(
+                        loaded,
+                        robot,
+                        profile,
+                        duration,
+                        on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+                        stop=stop,
+                        recorder=recorder,
+                    )
+                if recorder is not None:
+                    recorder.close()
+            except BaseException:
+                if recorder is not None:
+                    recorder.abort()
+                raise
     metrics = follow_metrics(result.log, _metric_params(loaded))
-    title = f"{loaded.name}, seed {robot.seed}"
+    title = loaded.name if seed_used is None else f"{loaded.name}, seed {seed_used}"
     layout = loaded.layout()
     files = [
-        ("metrics.json", json.dumps(_follow_json(metrics, result, robot.seed), indent=2) + "\n"),
+        ("metrics.json", json.dumps(_follow_json(metrics, result, seed_used), indent=2) + "\n"),
         ("trajectory.png", png_bytes(trajectory_figure(layout, result.log, metrics, title))),
         ("timeline.png", png_bytes(timeline_figure(result.log, metrics))),
     ]
     written = _write(out, files)
     _follow_report(metrics, result, written)
+    _end(result)
+
+
+def _run_hsr(
+    mission: Mission,
+    profile: TargetProfile,
+    duration: float,
+    console: Console,
+    what: str,
+    *,
+    until_found: bool = False,
+) -> EpisodeResult:
+    """The follower on the HSR over ROS 1 (``backend.hsr``) for ``duration`` s of ROS time; the
+    simulator's truth is recorded for the metrics when ``pfctl sim serve-hsr`` publishes it."""
+    from pfctl.backends.hsr.robot import HsrRobot
+
+    robot = HsrRobot(mission)
+    with robot, _worker_errors():
+        truth = robot.ground_truth if robot.ground_truth() is not None else None
+        with graceful_interrupts() as stop, _progress(console, duration, "s") as bar:
+            task = bar.add_task(what, total=duration)
+            return run_episode(
+                mission,
+                robot,
+                profile,
+                duration,
+                detector=robot.person_detector(),
+                now=lambda: robot.time,
+                truth=truth,  # type: ignore[arg-type]
+                kind="real",
+                on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+                stop=stop,
+                until_found=until_found,
+            )
+
+
+def _end(result: EpisodeResult) -> None:
+    """Exit 1 with one line when the robot was lost, 130 when interrupted (the outputs of what
+    was measured are written first)."""
+    if result.lost is not None:
+        sys.stderr.write(f"pfctl: error: {result.lost}; the base was stopped\n")
+        raise typer.Exit(1)
     if result.interrupted:
         raise typer.Exit(130)
 
@@ -308,7 +425,9 @@ def _recorder(record: Path | None, mission: Mission) -> EpisodeRecorder | None:
         raise UserError(str(err)) from None
 
 
-def _follow_json(metrics: FollowMetrics, result: EpisodeResult, seed: int) -> dict[str, object]:
+def _follow_json(
+    metrics: FollowMetrics, result: EpisodeResult, seed: int | None
+) -> dict[str, object]:
     data = metrics.to_json()
     ticks = np.asarray(result.tick_seconds) * 1000.0
     data.update(
@@ -316,6 +435,7 @@ def _follow_json(metrics: FollowMetrics, result: EpisodeResult, seed: int) -> di
         sim_time_s=round(result.sim_time, 3),
         wall_time_s=round(result.wall_time, 3),
         interrupted=result.interrupted,
+        lost=result.lost,
         tick_ms_median=round(float(np.median(ticks)), 3) if len(ticks) else None,
         tick_ms_p99=round(float(np.percentile(ticks, 99)), 3) if len(ticks) else None,
     )
@@ -352,14 +472,18 @@ def _follow_report(metrics: FollowMetrics, result: EpisodeResult, written: list[
 
 def search(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
-    backend: Annotated[str, typer.Option("--backend", help="Where to run: sim.")] = "sim",
+    backend: Annotated[
+        str, typer.Option("--backend", help="Where to run: sim (PyBullet) or hsr (ROS 1).")
+    ] = "sim",
     target: Annotated[
         Path | None,
-        typer.Option("--target", help="A target profile (pfctl learn-target); default: learn."),
+        typer.Option(
+            "--target", help="A target profile (pfctl learn-target); default (sim): learn."
+        ),
     ] = None,
     region: Annotated[
         str | None,
-        typer.Option("--region", help="Where the target hides (default: chosen by the seed)."),
+        typer.Option("--region", help="Sim: where the target hides (default: chosen by the seed)."),
     ] = None,
     seed: Annotated[
         int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
@@ -371,42 +495,51 @@ def search(
     gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
 ) -> None:
     """Find the mission's target somewhere in the house: belief, Algorithm 1 and frontiers."""
-    from pfctl.backends.pybullet.runner import graceful_interrupts
     from pfctl.follow_plots import search_figure
     from pfctl.prediction_plots import png_bytes
 
-    _check_common(backend, duration, out)
+    _check_common(backend, duration, out, target, None, gui)
+    if region is not None and backend == "hsr":
+        raise UserError(
+            "--region: only with --backend sim (the person hides themselves; with serve-hsr: "
+            "pfctl sim serve-hsr --hide REGION)"
+        )
     loaded = load_mission(mission)
     names = [r.name for r in loaded.map.regions]
     if region is not None and region not in names:
         raise UserError(f"--region {region}: unknown region (regions: {', '.join(names)})")
     console = Console(stderr=True)
     profile = _profile(loaded, target, seed, console, str(mission))
-    robot = _sim_robot(loaded, seed, gui, str(mission))
-    with robot, _worker_errors():
-        hidden_in = hide_target(robot, region)
-        with graceful_interrupts() as stop, _progress(console, duration) as bar:
-            task = bar.add_task("searching", total=duration)
-            result = run_sim_episode(
-                loaded,
-                robot,
-                profile,
-                duration,
-                on_tick=lambda t: bar.update(task, completed=min(t, duration)),
-                stop=stop,
-                until_found=True,
-            )
+    hidden_in: str | None = None
+    seed_used: int | None = None
+    if backend == "hsr":
+        result = _run_hsr(loaded, profile, duration, console, "searching", until_found=True)
+    else:
+        robot = _sim_robot(loaded, seed, gui, str(mission))
+        seed_used = robot.seed
+        with robot, _worker_errors():
+            hidden_in = hide_target(robot, region)
+            with graceful_interrupts() as stop, _progress(console, duration) as bar:
+                task = bar.add_task("searching", total=duration)
+                result = run_sim_episode(
+                    loaded,
+                    robot,
+                    profile,
+                    duration,
+                    on_tick=lambda t: bar.update(task, completed=min(t, duration)),
+                    stop=stop,
+                    until_found=True,
+                )
     metrics = search_metrics(result.log, _metric_params(loaded))
     data = metrics.to_json()
-    data.update(seed=robot.seed, region=hidden_in, sim_time_s=round(result.sim_time, 3))
+    data.update(seed=seed_used, region=hidden_in, sim_time_s=round(result.sim_time, 3))
     files = [
         ("metrics.json", json.dumps(data, indent=2) + "\n"),
         ("search.png", png_bytes(search_figure(loaded.layout(), result.log, metrics))),
     ]
     written = _write(out, files)
     _search_report(metrics, result, written)
-    if result.interrupted:
-        raise typer.Exit(130)
+    _end(result)
 
 
 def hide_target(robot: SimRobot, region: str | None) -> str:

@@ -10,6 +10,10 @@ and the 128-D embeddings of their face. Two sources:
   Frames from the simulated camera go through the mask person detector (the simulator's
   stand-in for OpenPose); the person is the detection nearest the spot they were asked to
   stand on, as a person on a real robot would be asked to stand in front of it.
+- ``--backend hsr``: the same on a Toyota HSR over ROS 1 (or the simulated house served by
+  ``pfctl sim serve-hsr --pose-target``): the person stands :data:`STAND_DISTANCE` m straight in
+  front of the robot, which stands still and nods its head between a face and a body height for
+  ``--seconds`` of ROS time; detections come from the mission's ``backend.hsr.person_labels``.
 - ``--from PATH``: a folder of images (``.png``, ``.jpg``, ...), one image, or a video file (at
   most :data:`MAX_VIDEO_FRAMES` frames, evenly spaced) of the person, read with OpenCV. Each
   image is searched with OpenCV's HOG people detector. When it finds nobody and the image is
@@ -47,8 +51,8 @@ from pfctl.core.identity import (
     describe,
     learn_profile,
 )
-from pfctl.core.robot import HeadTarget, Pose2D
-from pfctl.core.vision import HogPersonDetector, PersonDetection, hog_available
+from pfctl.core.robot import STOP, HeadTarget, Pose2D, RgbdFrame, Robot
+from pfctl.core.vision import HogPersonDetector, PersonDetection, PersonDetector, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import identity_params
@@ -67,8 +71,11 @@ SPOT_RADIUS = 0.6
 NOD_PERIOD = 2.0
 #: The target turns this far (rad) to either side while posing, so several views are learned.
 SWAY = 0.25
+#: On a robot (hsr): the heights the head nods between, metres (an adult's face and hips).
+FACE_HEIGHT = 1.55
+BODY_HEIGHT = 0.8
 
-BACKENDS = ("sim",)
+BACKENDS = ("sim", "hsr")
 
 
 @dataclass
@@ -160,19 +167,86 @@ def learn_in_sim(
             frame = robot.observe().rgbd
             if frame is None:
                 continue
-            learned.frames_seen += 1
-            detections = detector.detect(frame)
-            near = [
-                d
-                for d in detections
-                if math.hypot(d.position[0] - x, d.position[1] - y) < SPOT_RADIUS
-            ]
-            learned.others += len(detections) - len(near)
-            if not near:
-                continue
-            det = min(near, key=lambda d: math.hypot(d.position[0] - x, d.position[1] - y))
-            _add(learned, frame.rgb, det, params, encoder)
+            _learn_frame(learned, frame, detector, (x, y), params, encoder)
     return learned
+
+
+def learn_on_robot(
+    robot: Robot,
+    detector: PersonDetector,
+    seconds: float,
+    tick_hz: float,
+    params: IdentityParams,
+    progress: Progress,
+    now: Callable[[], float],
+    camera_height: float,
+) -> Learned:
+    """Frames of the person standing :data:`STAND_DISTANCE` m in front of a real robot (or the
+    simulated house served over ROS), for ``seconds`` of the robot's clock ``now()``: the base
+    stands still, the head looks straight ahead and nods between a face at
+    :data:`FACE_HEIGHT` and a body at :data:`BODY_HEIGHT`; the person is the detection nearest
+    the spot in front of the robot (within :data:`SPOT_RADIUS`)."""
+    learned = Learned([])
+    encoder = FaceEncoder(params.face)
+    start = now()
+    first = robot.observe()
+    spot = first.pose.compose(Pose2D(STAND_DISTANCE, 0.0))
+    task = progress.add_task("learning", total=max(1, math.ceil(seconds * tick_hz)))
+    while now() - start < seconds:
+        t = now() - start
+        look = FACE_HEIGHT if (t % NOD_PERIOD) < NOD_PERIOD / 2 else BODY_HEIGHT
+        robot.command(STOP, HeadTarget(0.0, math.atan2(look - camera_height, STAND_DISTANCE)))
+        robot.step()
+        progress.update(task, advance=1)
+        frame = robot.observe().rgbd
+        if frame is not None:
+            _learn_frame(learned, frame, detector, (spot.x, spot.y), params, encoder)
+    robot.command(STOP)
+    return learned
+
+
+def _learn_on_hsr(
+    mission: Mission, seconds: float, params: IdentityParams, progress: Progress
+) -> Learned:
+    """:func:`learn_on_robot` on the HSR over ROS 1 (``backend.hsr``)."""
+    from pfctl.backends.hsr.robot import HsrRobot
+
+    with HsrRobot(mission, node_name="pfctl_learn_target") as robot:
+        detector = robot.person_detector()
+        if detector is None:
+            raise UserError(
+                "backend.hsr.person_labels: is null, so the robot detects no one to learn"
+            )
+        return learn_on_robot(
+            robot,
+            detector,
+            seconds,
+            mission.behavior.tick_hz,
+            params,
+            progress,
+            now=lambda: robot.time,
+            camera_height=mission.sensors.camera.mount_height,
+        )
+
+
+def _learn_frame(
+    learned: Learned,
+    frame: RgbdFrame,
+    detector: PersonDetector,
+    spot: tuple[float, float],
+    params: IdentityParams,
+    encoder: FaceEncoder,
+) -> None:
+    """Learn from the person of ``frame`` nearest ``spot`` (others are counted)."""
+    learned.frames_seen += 1
+    detections = detector.detect(frame)
+    x, y = spot
+    near = [d for d in detections if math.hypot(d.position[0] - x, d.position[1] - y) < SPOT_RADIUS]
+    learned.others += len(detections) - len(near)
+    if not near:
+        return
+    det = min(near, key=lambda d: math.hypot(d.position[0] - x, d.position[1] - y))
+    _add(learned, frame.rgb, det, params, encoder)
 
 
 def _add(
@@ -314,7 +388,9 @@ def learn_target(
     out: Annotated[Path, typer.Option("--out", help="The target profile to write (.npz).")],
     backend: Annotated[
         str | None,
-        typer.Option("--backend", help="Learn on a robot: sim (default unless --from)."),
+        typer.Option(
+            "--backend", help="Learn on a robot: sim (default unless --from) or hsr (ROS 1)."
+        ),
     ] = None,
     source: Annotated[
         Path | None,
@@ -328,7 +404,7 @@ def learn_target(
         Path | None, typer.Option("--plot", help="Also write a PNG of the histograms and face.")
     ] = None,
     seconds: Annotated[
-        float, typer.Option("--seconds", help="With --backend sim: simulated seconds to look.")
+        float, typer.Option("--seconds", help="With --backend: seconds (sim or ROS time) to look.")
     ] = 6.0,
     seed: Annotated[
         int | None,
@@ -368,6 +444,9 @@ def learn_target(
         if source is not None:
             learned = learn_from_images(source, pick, params, progress)
             where = f"--from {source}"
+        elif backend == "hsr":
+            learned = _learn_on_hsr(loaded, seconds, params, progress)
+            where = f"--backend hsr: the person {STAND_DISTANCE:g} m in front of the robot"
         else:
             learned = learn_in_sim(loaded, seconds, seed, params, progress, str(mission))
             where = f"{mission}: the simulated target"

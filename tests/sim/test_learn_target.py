@@ -151,7 +151,7 @@ def test_several_people_need_pick_which_takes_the_nth_from_the_left(pictures) ->
 @pytest.mark.parametrize(
     ("extra", "words"),
     [
-        (["--backend", "hsr"], "--backend hsr: expected one of sim"),
+        (["--backend", "gazebo"], "--backend gazebo: expected one of sim, hsr"),
         (["--pick", "1"], "--pick 1: expected a positive number, with --from"),
         (["--from", "nowhere"], "--from nowhere: no such file or folder"),
         (["--seconds", "0"], "--seconds"),

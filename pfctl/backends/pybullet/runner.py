@@ -10,11 +10,8 @@ two periods: the result says ``interrupted`` and what was recorded so far is a c
 
 from __future__ import annotations
 
-import contextlib
-import signal
-import threading
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -22,6 +19,7 @@ from pfctl.backends.pybullet.drivers import KeyboardDriver, ScriptStep
 from pfctl.backends.pybullet.recording import EpisodeRecorder
 from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.core.robot import STOP, GroundTruth
+from pfctl.interrupts import StopFlag, graceful_interrupts
 
 
 class Driver(Protocol):
@@ -47,36 +45,6 @@ class RunResult:
     @property
     def real_time_factor(self) -> float:
         return self.sim_time / self.wall_time if self.wall_time > 0 else float("inf")
-
-
-class StopFlag:
-    """Set by the first Ctrl-C inside :func:`graceful_interrupts`."""
-
-    def __init__(self) -> None:
-        self.set = False
-
-    def __call__(self) -> bool:
-        return self.set
-
-
-@contextlib.contextmanager
-def graceful_interrupts() -> Iterator[StopFlag]:
-    """While open, the first SIGINT sets the flag instead of raising; the second raises."""
-    flag = StopFlag()
-    if threading.current_thread() is not threading.main_thread():
-        yield flag
-        return
-
-    def handler(signum: int, frame: object) -> None:
-        if flag.set:
-            raise KeyboardInterrupt
-        flag.set = True
-
-    previous = signal.signal(signal.SIGINT, handler)
-    try:
-        yield flag
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 def run_episode(
