@@ -7,7 +7,10 @@
   ``/tf_static``) has them, else the scan's own frame (a stationary laser);
 - the camera, when the bag has an RGB ``sensor_msgs/Image`` topic, a depth image and a
   ``sensor_msgs/CameraInfo`` (the HSR's and the simulator's topic names, or any ``…rgb…image…`` /
-  ``…depth…image…`` / ``…camera_info`` triple); images and depth pair up by stamp.
+  ``…depth…image…`` / ``…camera_info`` triple); images and depth pair up by stamp; a person-label
+  image (``/pfctl/person_labels``, :mod:`pfctl.backends.hsr.person_labels`, as ``pfctl sim
+  serve-hsr`` or a person detector on the robot publishes it) of the same stamp becomes the
+  frame's ``mask``.
 
 :meth:`Replay.stream` then yields :class:`~pfctl.core.robot.LaserScan` and
 :class:`~pfctl.core.robot.RgbdFrame` values in bag order, posed in the fixed frame through the
@@ -47,6 +50,8 @@ KNOWN_CAMERAS = (
 )
 #: An image and a depth image at most this far apart (s) are one RGB-D frame.
 SYNC_SLOP = 0.02
+#: Person labels (an instance/part image, :mod:`pfctl.backends.hsr.person_labels`) tried first.
+KNOWN_LABELS = ("/pfctl/person_labels",)
 
 
 @dataclass(frozen=True)
@@ -56,6 +61,15 @@ class CameraTopics:
     rgb: str
     depth: str
     info: str
+    labels: str | None = None
+    """A 16UC1 person-label image of the same stamps (the frames' ``mask``), if the bag has one."""
+
+    def images(self) -> dict[str, str]:
+        """Image topic by kind: ``rgb``, ``depth`` and, when known, ``labels``."""
+        kinds = {"rgb": self.rgb, "depth": self.depth}
+        if self.labels is not None:
+            kinds["labels"] = self.labels
+        return kinds
 
 
 @dataclass
@@ -78,7 +92,7 @@ class Replay:
         """How many messages :meth:`stream` reads (for a progress bar)."""
         topics = [self.scan_topic]
         if self.camera is not None:
-            topics += [self.camera.rgb, self.camera.depth, self.camera.info]
+            topics += [*self.camera.images().values(), self.camera.info]
         return sum(self.bag.count(t) for t in topics)
 
     def _skip(self, reason: str) -> None:
@@ -89,10 +103,12 @@ class Replay:
         message read (so a caller can advance a progress bar per message)."""
         topics = [self.scan_topic]
         cam = self.camera
+        kinds: dict[str, str] = {}
         if cam is not None:
-            topics += [cam.rgb, cam.depth, cam.info]
+            kinds = {topic: kind for kind, topic in cam.images().items()}
+            topics += [*kinds, cam.info]
         info: CameraInfo | None = None
-        images: dict[str, tuple[float, Any] | None] = {"rgb": None, "depth": None}
+        images: dict[str, tuple[float, Any]] = {}
         for m in self.bag.messages(topics):
             if m.topic == self.scan_topic:
                 frame_id, scan = laser_scan(m.msg)
@@ -104,18 +120,20 @@ class Replay:
                 info = _camera_info(m.msg)
                 yield None
                 continue
-            kind = "rgb" if m.topic == cam.rgb else "depth"
-            images[kind] = (stamp_seconds(m.msg.header), m.msg)
-            rgb, depth = images["rgb"], images["depth"]
-            if rgb is None or depth is None or abs(rgb[0] - depth[0]) > SYNC_SLOP:
+            stamp = stamp_seconds(m.msg.header)
+            images[kinds[m.topic]] = (stamp, m.msg)
+            if len(images) < len(kinds) or any(
+                abs(t - stamp) > SYNC_SLOP for t, _ in images.values()
+            ):
                 yield None
                 continue
-            images = {"rgb": None, "depth": None}
+            msgs = {kind: msg for kind, (_, msg) in images.items()}
+            images = {}
             if info is None:
                 self._skip("frame before any camera_info")
                 yield None
                 continue
-            yield self._frame(rgb[1], depth[1], info)
+            yield self._frame(msgs["rgb"], msgs["depth"], msgs.get("labels"), info)
 
     def _pose(self, frame_id: str, stamp: float) -> Pose2D | None:
         if frame_id.lstrip("/") == self.frame:
@@ -126,7 +144,9 @@ class Replay:
             self._skip(f"no transform {self.frame} ← {frame_id}")
             return None
 
-    def _frame(self, rgb_msg: Any, depth_msg: Any, info: CameraInfo) -> RgbdFrame | None:
+    def _frame(
+        self, rgb_msg: Any, depth_msg: Any, labels_msg: Any | None, info: CameraInfo
+    ) -> RgbdFrame | None:
         stamp = stamp_seconds(rgb_msg.header)
         frame_id = rgb_msg.header.frame_id
         try:
@@ -139,8 +159,12 @@ class Replay:
         if depth.shape != rgb.shape[:2]:
             self._skip("depth image of another size than the colour image")
             return None
+        labels = None if labels_msg is None else image_labels(labels_msg)
+        if labels is not None and labels.shape != rgb.shape[:2]:
+            self._skip("person labels of another size than the colour image")
+            return None
         x, y, z = (float(v) for v in m[:3, 3])
-        return RgbdFrame(stamp, rgb, depth, info, (x, y, z), m[:3, :3].copy())
+        return RgbdFrame(stamp, rgb, depth, info, (x, y, z), m[:3, :3].copy(), mask=labels)
 
 
 def image_rgb(msg: Any) -> np.ndarray:
@@ -178,6 +202,16 @@ def image_depth(msg: Any) -> np.ndarray:
     return out
 
 
+def image_labels(msg: Any) -> np.ndarray:
+    """A ``16UC1``/``mono16`` person-label image as ``(h, w) int32``."""
+    if msg.encoding.upper() not in ("16UC1", "MONO16"):
+        raise UserError(f"person label encoding {msg.encoding!r} is not supported (16UC1)")
+    dtype = np.dtype(">u2" if msg.is_bigendian else "<u2")
+    data = np.frombuffer(bytes(msg.data), dtype=np.uint8).reshape(msg.height, msg.step)
+    rows = data[:, : msg.width * 2].copy().view(dtype).reshape(msg.height, msg.width)
+    return rows.astype(np.int32)
+
+
 def _camera_info(msg: Any) -> CameraInfo:
     k = msg.K if hasattr(msg, "K") else msg.k  # ROS 1 spells it K, ROS 2 k
     a, b, c, d, e, f, g, h, i = (float(v) for v in k)
@@ -207,17 +241,18 @@ def _read_tf(bag: Bag) -> TransformBuffer:
 
 def _find_camera(bag: Bag) -> CameraTopics | None:
     have = bag.topics
+    labels = next((t for t in KNOWN_LABELS if have.get(t) == IMAGE), None)
     for rgb, depth, info in KNOWN_CAMERAS:
         if have.get(rgb) == IMAGE and have.get(depth) == IMAGE and have.get(info) == CAMERA_INFO:
-            return CameraTopics(rgb, depth, info)
-    images = sorted(t for t, m in have.items() if m == IMAGE)
+            return CameraTopics(rgb, depth, info, labels)
+    images = sorted(t for t, m in have.items() if m == IMAGE and t != labels)
     rgbs = [t for t in images if "rgb" in t or "color" in t]
     depths = [t for t in images if "depth" in t]
     infos = sorted(t for t, m in have.items() if m == CAMERA_INFO)
     if len(rgbs) == 1 and len(depths) == 1 and infos:
         ns = rgbs[0].rsplit("/", 1)[0]
         info = next((i for i in infos if i.startswith(ns)), infos[0])
-        return CameraTopics(rgbs[0], depths[0], info)
+        return CameraTopics(rgbs[0], depths[0], info, labels)
     return None
 
 
@@ -277,6 +312,7 @@ __all__ = [
     "CameraTopics",
     "Replay",
     "image_depth",
+    "image_labels",
     "image_rgb",
     "open_replay",
 ]

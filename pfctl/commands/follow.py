@@ -5,8 +5,9 @@ the follower (:mod:`pfctl.core.follower`) in the simulated house for ``--duratio
 seconds: it follows the target, loses them, predicts, goes and looks, searches by Algorithm 1,
 re-identifies them and follows again, as the mission's behavior tree decides. Prints a summary
 (following rate, losses, each re-acquisition and how, identity switches, collisions, distance)
-and writes ``trajectory.png`` (Fig. 4), ``timeline.png`` (Fig. 6) and ``metrics.json`` into
-``--out``.
+and writes ``trajectory.png`` (Fig. 4), ``timeline.png`` (Fig. 6), ``metrics.json`` and
+``tracks.csv`` (the people tracks after each tick with a scan, as ``pfctl replay`` writes them
+for a bag) into ``--out``.
 
 ``pfctl search MISSION --backend sim``: the target stands somewhere in the house out of view
 (``--region``, else a region away from the robot chosen by the seed); the robot searches until
@@ -41,6 +42,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
+from pfctl.commands.replay import tracks_csv
 from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.episode import EpisodeLog, TickRecord
 from pfctl.core.episode_metrics import (
@@ -314,7 +316,10 @@ def follow(
         float, typer.Option("--duration", help="Seconds (simulated, or ROS time on hsr).")
     ] = 120.0,
     out: Annotated[
-        Path, typer.Option("--out", help="Folder for trajectory.png, timeline.png, metrics.json.")
+        Path,
+        typer.Option(
+            "--out", help="Folder for trajectory.png, timeline.png, metrics.json, tracks.csv."
+        ),
     ] = Path("out/follow"),
     record: Annotated[
         Path | None,
@@ -362,6 +367,7 @@ def follow(
         ("metrics.json", json.dumps(_follow_json(metrics, result, seed_used), indent=2) + "\n"),
         ("trajectory.png", png_bytes(trajectory_figure(layout, result.log, metrics, title))),
         ("timeline.png", png_bytes(timeline_figure(result.log, metrics))),
+        ("tracks.csv", tracks_csv(result.log.tracks)),
     ]
     written = _write(out, files)
     _follow_report(metrics, result, written)

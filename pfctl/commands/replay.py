@@ -1,7 +1,8 @@
 """``pfctl replay BAG``: the perception run on a recorded bag → ``tracks.csv`` and ``tracks.png``.
 
 Leg detection and tracking run on every scan of the bag (and, when the bag has RGB-D topics,
-person detection fuses into the same tracks; with ``--target`` Algorithm 2 names the target),
+person detection — from the bag's person-label image when it has one (``/pfctl/person_labels``),
+else OpenCV's HOG — fuses into the same tracks; with ``--target`` Algorithm 2 names the target),
 posed in a fixed frame through the bag's ``/tf``. After each scan, every confirmed track that is
 currently seen (coasting tracks are left out: they are extrapolations) is one row of
 ``tracks.csv``: ``t,track_id,x,y,vx,vy,confidence,is_target``. ``tracks.png`` draws the tracks
@@ -22,13 +23,14 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.bag_replay import Replay, open_replay
 from pfctl.core.atomic_files import atomic_write_all
+from pfctl.core.episode import TrackRow
 from pfctl.core.identity import TargetProfile
-from pfctl.core.perception import Perception, track_rows
+from pfctl.core.perception import Perception
 from pfctl.core.robot import LaserScan, RgbdFrame
-from pfctl.core.tracking import TrackStatus
-from pfctl.core.vision import HogPersonDetector, hog_available
+from pfctl.core.vision import HogPersonDetector, PersonDetector, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import build_perception
@@ -91,14 +93,16 @@ def replay(
             raise UserError(
                 f"{bag}: --target needs the bag's camera (RGB, depth and camera_info topics)"
             )
-        detector = None
-        if source.camera is not None:
+        detector: PersonDetector | None = None
+        if source.camera is not None and source.camera.labels is not None:
+            detector = label_detector(mission.perception.vision.min_pixels)
+        elif source.camera is not None:
             if not hog_available():
                 raise UserError("the camera needs OpenCV's HOG people detector (OpenCV < 5)")
             detector = HogPersonDetector()
         perception = build_perception(mission, detector=detector, profile=profile)
         rows, points, frames = _run(source, perception, console)
-    csv_text = _csv(rows)
+    csv_text = tracks_csv(rows)
     png = _plot(source, rows, points, bag.name)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_all([(out / "tracks.csv", csv_text), (out / "tracks.png", png)])
@@ -115,13 +119,10 @@ def replay(
         print(f"note: skipped {count} messages: {reason}", file=sys.stderr)
 
 
-Row = tuple[float, int, float, float, float, float, float, bool]
-
-
 def _run(
     source: Replay, perception: Perception, console: Console
-) -> tuple[list[Row], np.ndarray, int]:
-    rows: list[Row] = []
+) -> tuple[list[TrackRow], np.ndarray, int]:
+    rows: list[TrackRow] = []
     backdrop: list[np.ndarray] = []
     frames = 0
     with progress_bar(console, "replaying", source.total()) as advance:
@@ -129,9 +130,7 @@ def _run(
             advance(1)
             if isinstance(item, LaserScan):
                 perception.on_scan(item)
-                target = perception.target()
-                seen = [t for t in perception.tracks() if t.status is TrackStatus.CONFIRMED]
-                rows += track_rows(item.stamp, seen, target and target.id)
+                rows += perception.seen_track_rows(item.stamp)
                 backdrop.append(item.points()[::4])
             elif isinstance(item, RgbdFrame):
                 perception.on_frame(item)
@@ -142,7 +141,8 @@ def _run(
     return rows, points, frames
 
 
-def _csv(rows: list[Row]) -> str:
+def tracks_csv(rows: list[TrackRow]) -> str:
+    """The rows as ``tracks.csv`` (:data:`COLUMNS`; mm and mm/s resolution)."""
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
     writer.writerow(COLUMNS)
@@ -154,7 +154,7 @@ def _csv(rows: list[Row]) -> str:
     return buf.getvalue()
 
 
-def _plot(source: Replay, rows: list[Row], points: np.ndarray, title: str) -> bytes:
+def _plot(source: Replay, rows: list[TrackRow], points: np.ndarray, title: str) -> bytes:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -171,7 +171,7 @@ def _plot(source: Replay, rows: list[Row], points: np.ndarray, title: str) -> by
                   extent=(x0, x0 + w * r, y0, y0 + h * r))  # fmt: skip
     elif len(points):
         ax.scatter(points[:, 0], points[:, 1], s=0.3, c="0.7", linewidths=0, label="laser returns")
-    by_id: dict[int, list[Row]] = {}
+    by_id: dict[int, list[TrackRow]] = {}
     for row in rows:
         by_id.setdefault(row[1], []).append(row)
     cmap = plt.get_cmap("tab20")
@@ -201,4 +201,4 @@ def _plot(source: Replay, rows: list[Row], points: np.ndarray, title: str) -> by
     return buf.getvalue()
 
 
-__all__ = ["COLUMNS", "replay"]
+__all__ = ["COLUMNS", "replay", "tracks_csv"]

@@ -49,6 +49,10 @@ class TickRecord:
     """What the head looked at: ``target``, ``belief``, ``legs``, ``sweep`` or ``none``."""
 
 
+TrackRow = tuple[float, int, float, float, float, float, float, bool]
+"""``(t, track_id, x, y, vx, vy, confidence, is_target)``."""
+
+
 @dataclass(frozen=True, eq=False)
 class PredictionRecord:
     """A prediction made when the target was lost: where from and where to (map frame)."""
@@ -83,6 +87,10 @@ class EpisodeLog:
     waypoints: list[WaypointRecord] = field(default_factory=list)
     target_name: str | None = None
     """The scenario's target (simulator), for the metrics."""
+    tracks: list[TrackRow] = field(default_factory=list)
+    """After each tick with a laser scan, one row per confirmed track seen then (coasting ones
+    are left out), stamped with the scan: what ``pfctl replay`` writes for a bag
+    (:func:`pfctl.core.perception.track_rows`)."""
 
 
 __all__ = [
@@ -91,5 +99,6 @@ __all__ = [
     "EpisodeLog",
     "PredictionRecord",
     "TickRecord",
+    "TrackRow",
     "WaypointRecord",
 ]

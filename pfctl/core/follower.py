@@ -141,6 +141,8 @@ class Follower:
         now = obs.stamp
         self._now = now
         self._perceive(obs)
+        if obs.scan is not None:
+            self.log.tracks += self.perception.seen_track_rows(obs.scan.stamp)
         target = self._target_state(now)
         visible = target is not None and now - target.last_detected <= self.params.visible_age
         self._update_sightings(now, target, visible)

@@ -22,10 +22,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from pfctl.core.belief import HumanBelief
+from pfctl.core.episode import TrackRow
 from pfctl.core.identity import TargetIdentifier, TrackIdentity
 from pfctl.core.legs import LegDetections, LegDetector
 from pfctl.core.robot import LaserScan, Observation, RgbdFrame
-from pfctl.core.tracking import Detection, FieldOfView, MultiPersonTracker, Track
+from pfctl.core.tracking import Detection, FieldOfView, MultiPersonTracker, Track, TrackStatus
 from pfctl.core.vision import PersonDetection, PersonDetector
 
 
@@ -126,6 +127,14 @@ class Perception:
         track_id = self.identifier.target_track()
         return None if track_id is None else self.tracker.track(track_id)
 
+    def seen_track_rows(self, stamp: float) -> list[TrackRow]:
+        """One :func:`track_rows` row per confirmed track seen now (coasting tracks, which are
+        extrapolations, are left out), stamped ``stamp``: what ``pfctl replay`` writes after a
+        scan and what the follower logs after each tick with a scan."""
+        seen = [t for t in self.tracks() if t.status is TrackStatus.CONFIRMED]
+        target = self.target()
+        return track_rows(stamp, seen, target and target.id)
+
     def has_legs(self, track_id: int) -> bool:
         """Whether the laser has associated leg detections with ``track_id``."""
         return track_id in self._leg_tracks
@@ -136,9 +145,7 @@ class Perception:
             self.identifier.close()
 
 
-def track_rows(
-    stamp: float, tracks: Sequence[Track], target_id: int | None
-) -> list[tuple[float, int, float, float, float, float, float, bool]]:
+def track_rows(stamp: float, tracks: Sequence[Track], target_id: int | None) -> list[TrackRow]:
     """One ``(t, track_id, x, y, vx, vy, confidence, is_target)`` row per track."""
     return [(stamp, t.id, t.x, t.y, t.vx, t.vy, t.confidence, t.id == target_id) for t in tracks]
 
