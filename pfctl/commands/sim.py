@@ -6,6 +6,9 @@
   paths on a top-down PNG and print what happened.
 - ``export-map MISSION --out map.yaml``: the static occupancy grid the simulator's walls and
   furniture imply (:func:`pfctl.core.walls.rasterize_house`), as a ROS map_server map.
+- ``serve-hsr MISSION``: the house as a Toyota HSR on the ROS 1 master of ``ROS_MASTER_URI``
+  (:mod:`pfctl.backends.hsr.sim_bridge`: the topics, tf, move_base and services of the mission's
+  ``backend.hsr``, on a ``/clock`` of simulated time) until ``--duration`` or Ctrl-C / SIGTERM.
 
 Every bad input is a :class:`pfctl.errors.UserError` (one line, exit 2); files are written
 atomically.
@@ -13,11 +16,13 @@ atomically.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import os
+import signal
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -29,10 +34,13 @@ from pfctl.core.grid import GridFileError
 from pfctl.core.planning import NoPathError
 from pfctl.core.walls import rasterize_house
 from pfctl.errors import UserError
+from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
 if TYPE_CHECKING:  # the simulator is imported when a command needs it: pybullet loads slowly
+    from pfctl.backends.hsr.sim_bridge import BridgeStats
     from pfctl.backends.pybullet.runner import RunResult
+    from pfctl.backends.pybullet.simulation import SimRobot
 
 app = typer.Typer(help="The simulated house: run it, export its map.", no_args_is_help=True)
 
@@ -261,4 +269,243 @@ def export_map(
     g = grid.geometry
     Console(width=100, soft_wrap=True).print(
         f"wrote {yaml_path} and {pgm_path.name}: {g.width}×{g.height} cells at {g.resolution:g} m"
+    )
+
+
+@app.command("serve-hsr")
+def serve_hsr(
+    mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
+    seed: Annotated[
+        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+    ] = None,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            "--duration",
+            help="Simulated seconds to serve (default: until Ctrl-C or SIGTERM).",
+            show_default=False,
+        ),
+    ] = None,
+    rate: Annotated[
+        float,
+        typer.Option("--rate", help="Simulated seconds per wall second; 0: as fast as possible."),
+    ] = 1.0,
+    depth_encoding: Annotated[
+        str,
+        typer.Option(
+            "--depth-encoding", help="Depth image: 16UC1 (mm, like the Xtion) or 32FC1 (m)."
+        ),
+    ] = "16UC1",
+    hide: Annotated[
+        str | None,
+        typer.Option(
+            "--hide",
+            help="Put the target standing still in this region, out of view (for pfctl search).",
+            show_default=False,
+        ),
+    ] = None,
+    pose_target: Annotated[
+        bool,
+        typer.Option(
+            "--pose-target",
+            help="The target stands 1.4 m in front of the robot, facing it "
+            "(for pfctl learn-target --backend hsr).",
+        ),
+    ] = False,
+    wait_for_command: Annotated[
+        bool,
+        typer.Option(
+            "--wait-for-command",
+            help="Hold the episode (the clock runs, nobody moves) until the robot is first "
+            "commanded: a follower started later sees the episode from its start.",
+        ),
+    ] = False,
+) -> None:
+    """Serve the simulated house as a Toyota HSR on the ROS 1 master of ROS_MASTER_URI: the
+    laser, RGB-D camera, person labels, odometry, tf, head and base commands, move_base and the
+    ground truth of the mission's backend.hsr, on /clock (use_sim_time; ROS time = simulated
+    time + 100 s)."""
+    from pfctl.backends.hsr.sim_bridge import DEPTH_ENCODINGS
+
+    if duration is not None and not (math.isfinite(duration) and duration > 0):
+        raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
+    if not (math.isfinite(rate) and rate >= 0):
+        raise UserError(f"--rate: expected a number >= 0 (0: as fast as possible), got {rate:g}")
+    if depth_encoding not in DEPTH_ENCODINGS:
+        raise UserError(
+            f"--depth-encoding {depth_encoding}: expected one of {', '.join(DEPTH_ENCODINGS)}"
+        )
+    if hide is not None and pose_target:
+        raise UserError("--hide and --pose-target: expected at most one of them, got both")
+    loaded = load_mission(mission)
+    regions = [r.name for r in loaded.map.regions]
+    if hide is not None and hide not in regions:
+        raise UserError(f"--hide {hide}: unknown region (regions: {', '.join(regions)})")
+    console = Console(stderr=True)
+    with graceful_interrupts() as stop, _terminate_sets(stop):
+        stats = _serve(
+            loaded,
+            mission,
+            seed,
+            duration,
+            rate,
+            depth_encoding,
+            hide,
+            pose_target,
+            wait_for_command,
+            stop,
+            console,
+        )
+    _serve_report(stats)
+    if stats.lost is not None:
+        sys.stderr.write(f"pfctl: error: {stats.lost}\n")
+        raise typer.Exit(1)
+
+
+@contextlib.contextmanager
+def _terminate_sets(flag: StopFlag) -> Iterator[None]:
+    """While open, SIGTERM sets ``flag`` (as the first Ctrl-C does) instead of killing."""
+
+    def handler(signum: int, frame: object) -> None:
+        flag.set = True
+
+    previous = signal.signal(signal.SIGTERM, handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _serve(
+    mission: Mission,
+    path: Path,
+    seed: int | None,
+    duration: float | None,
+    rate: float,
+    depth_encoding: str,
+    hide: str | None,
+    pose_target: bool,
+    wait_for_command: bool,
+    stop: StopFlag,
+    console: Console,
+) -> BridgeStats:
+    from pfctl.backends.hsr.ros_import import import_rospy
+    from pfctl.backends.hsr.sim_bridge import (
+        CLOCK_OFFSET,
+        SimHsrBridge,
+        check_master,
+        claim_sim_time,
+        master_uri,
+    )
+
+    import_rospy()  # ROS 1 missing: one line naming the apt packages
+    uri = master_uri()
+    check_master(uri)
+    claim_sim_time(uri)  # before the simulator loads: a node reads /use_sim_time as it starts
+    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+
+    try:
+        robot = SimRobot(mission, SimOptions(seed=seed))
+    except NoPathError as err:
+        raise UserError(f"{path}: scenario.people: a route cannot be walked: {err}") from None
+    with robot:
+        scene = None
+        if hide is not None:
+            from pfctl.commands.follow import hide_target
+
+            hide_target(robot, hide)
+        elif pose_target:
+            scene = _posing(robot, str(path))
+        bridge = SimHsrBridge(
+            robot,
+            uri,
+            rate=rate,
+            depth_encoding=depth_encoding,
+            wait_for_command=wait_for_command,
+        )
+        pace = f"rate {rate:.1f}×" if rate > 0 else "as fast as possible"
+
+        def ready() -> None:
+            console.print(
+                f"serving {path} as an HSR on {uri.rstrip('/')}, seed {robot.seed}, {pace} "
+                f"(ROS time = simulated time + {CLOCK_OFFSET:g} s"
+                + (", held until the first command)" if wait_for_command else ")"),
+                highlight=False,
+                soft_wrap=True,
+            )
+
+        def released(held: float) -> None:
+            console.print(
+                f"the first command came after {held:.2f} s: the episode starts "
+                f"(ROS time = simulated time + {CLOCK_OFFSET + held:.3f} s)",
+                highlight=False,
+                soft_wrap=True,
+            )
+
+        try:
+            if stop():
+                return bridge.stats
+            bridge.start()
+            with _ServeProgress(console, duration) as tick:
+                return bridge.run(
+                    duration,
+                    stop,
+                    on_period=tick,
+                    scene=scene,
+                    on_ready=ready,
+                    on_release=released,
+                )
+        finally:
+            bridge.shutdown("interrupted" if stop() else "done")
+
+
+def _posing(robot: SimRobot, source: str) -> Callable[[float], None]:
+    """Hold the target in front of the robot (as ``pfctl learn-target`` does in the simulator),
+    turning a little from side to side; the scene callback that keeps them there."""
+    from pfctl.commands.learn_target import SWAY, stand_in_front
+
+    x, y, _ = stand_in_front(robot, source=source)
+    target = next(w for w in robot.people if w.is_target)
+    facing = target.theta
+    robot.resense()
+
+    def scene(t: float) -> None:
+        target.hold(x, y, facing + SWAY * math.sin(2 * math.pi * t / 3.0))
+
+    return scene
+
+
+class _ServeProgress:
+    """Simulated time served, on stderr when it is a terminal (a bar with ``--duration``)."""
+
+    def __init__(self, console: Console, duration: float | None) -> None:
+        self.duration = duration
+        self.bar = Progress(
+            TextColumn("serving"),
+            BarColumn(),
+            TextColumn("{task.completed:.1f} s simulated"),
+            console=console,
+            transient=True,
+            disable=not console.is_terminal,
+        )
+
+    def __enter__(self) -> Callable[[float], None]:
+        self.bar.__enter__()
+        task = self.bar.add_task("serve", total=self.duration)
+        return lambda t: self.bar.update(task, completed=t)
+
+    def __exit__(self, *exc: object) -> None:
+        self.bar.__exit__(None, None, None)
+
+
+def _serve_report(stats: BridgeStats) -> None:
+    status = "interrupted after" if stats.interrupted else "served"
+    held = f" (after holding for {stats.held:.1f} s)" if stats.held > 0 else ""
+    Console(width=100, soft_wrap=True).print(
+        f"{status} {stats.sim_time:.1f} s simulated{held} in {stats.wall_time:.1f} s "
+        f"({stats.real_time_factor:.2f}× real time): {stats.scans} scans, {stats.frames} camera "
+        f"frames; received {stats.velocity_commands} velocity commands, {stats.head_commands} "
+        f"head commands, {stats.goals} move_base goals, {stats.viewpoint_stops} viewpoint stops; "
+        f"{stats.collisions} collisions",
+        highlight=False,
     )

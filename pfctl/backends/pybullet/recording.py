@@ -103,6 +103,80 @@ _TF_MSG = "geometry_msgs/TransformStamped[] transforms\n"
 _PERSON_TEXT = re.compile(r"^(target|distractor) speed=([-+0-9.eE]+)$")
 
 
+# --------------------------------------------------------------------------------------------
+# the encoding shared with ``pfctl sim serve-hsr`` (pure: no message library)
+
+
+@dataclass(frozen=True)
+class PersonMarker:
+    """The fields of one person's ``visualization_msgs/Marker`` in ``/ground_truth/people``."""
+
+    ns: str
+    """The person's name."""
+    id: int
+    pose: Pose2D
+    """Position and heading in the map frame."""
+    z: float
+    scale: tuple[float, float, float]
+    color: tuple[float, float, float, float]
+    """Red for the target, blue for a distractor (r, g, b, a)."""
+    text: str
+    """``"target speed=0.800"`` or ``"distractor speed=0.800"``."""
+    lifetime: float
+    """Seconds."""
+    type: int = 3  # CYLINDER
+    action: int = 0  # ADD
+
+
+def person_marker(person: PersonTruth, index: int) -> PersonMarker:
+    """The marker of ``person``, the ``index``-th of the truth's people (see the module doc)."""
+    color = (0.85, 0.1, 0.1, 0.8) if person.is_target else (0.15, 0.35, 0.85, 0.8)
+    return PersonMarker(
+        ns=person.name,
+        id=index,
+        pose=Pose2D(person.x, person.y, person.theta),
+        z=0.85,
+        scale=(0.5, 0.5, 1.7),
+        color=color,
+        text=f"{'target' if person.is_target else 'distractor'} speed={person.speed:.3f}",
+        lifetime=0.2,
+    )
+
+
+def person_from_marker(ns: str, pose: Pose2D, text: str) -> PersonTruth:
+    """The person a marker of :func:`person_marker` encodes (its ``ns``, pose and ``text``)."""
+    match = _PERSON_TEXT.match(text)
+    return PersonTruth(
+        name=ns,
+        x=pose.x,
+        y=pose.y,
+        theta=pose.theta,
+        speed=float(match.group(2)) if match else 0.0,
+        is_target=bool(match and match.group(1) == "target"),
+    )
+
+
+def camera_in_base(
+    frame: RgbdFrame, base: Pose2D
+) -> tuple[tuple[float, float, float], tuple[float, float, float, float]]:
+    """The optical frame of ``frame`` seen from the base at ``base`` (both in the map frame):
+    the translation ``(x, y, z)`` and the rotation as a quaternion ``(x, y, z, w)`` of the
+    ``base_footprint → head_rgbd_sensor_rgb_frame`` transform (z forward, x right, y down)."""
+    map_base = np.eye(4)
+    map_base[:2, :2] = [
+        [math.cos(base.theta), -math.sin(base.theta)],
+        [math.sin(base.theta), math.cos(base.theta)],
+    ]
+    map_base[:2, 3] = (base.x, base.y)
+    map_camera = np.eye(4)
+    map_camera[:3, :3] = frame.camera_rotation
+    map_camera[:3, 3] = frame.camera_position
+    base_camera = np.linalg.solve(map_base, map_camera)
+    qx, qy, qz, qw = (float(v) for v in Rotation.from_matrix(base_camera[:3, :3]).as_quat())
+    x, y, z = (float(v) for v in base_camera[:3, 3])
+    return (x, y, z), (qx, qy, qz, qw)
+
+
 class RecordingError(ValueError):
     """An episode directory that cannot be written or read (the message names the path)."""
 
@@ -211,26 +285,13 @@ class EpisodeRecorder:
     def _camera_transform(self, frame: RgbdFrame, base: Pose2D) -> Any:
         """``base_footprint → head_rgbd_sensor_rgb_frame`` (3-D: the optical frame, z forward)."""
         t = self._types()
-        map_base = np.eye(4)
-        map_base[:2, :2] = [
-            [math.cos(base.theta), -math.sin(base.theta)],
-            [math.sin(base.theta), math.cos(base.theta)],
-        ]
-        map_base[:2, 3] = (base.x, base.y)
-        map_camera = np.eye(4)
-        map_camera[:3, :3] = frame.camera_rotation
-        map_camera[:3, 3] = frame.camera_position
-        base_camera = np.linalg.solve(map_base, map_camera)
-        qx, qy, qz, qw = Rotation.from_matrix(base_camera[:3, :3]).as_quat()
-        x, y, z = (float(v) for v in base_camera[:3, 3])
+        (x, y, z), (qx, qy, qz, qw) = camera_in_base(frame, base)
         return t["geometry_msgs/msg/TransformStamped"](
             header=self._header(frame.stamp, BASE_FRAME),
             child_frame_id=CAMERA_FRAME,
             transform=t["geometry_msgs/msg/Transform"](
                 translation=t["geometry_msgs/msg/Vector3"](x=x, y=y, z=z),
-                rotation=t["geometry_msgs/msg/Quaternion"](
-                    x=float(qx), y=float(qy), z=float(qz), w=float(qw)
-                ),
+                rotation=t["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw),
             ),
         )
 
@@ -404,23 +465,27 @@ class EpisodeRecorder:
         for i, person in enumerate(truth.people):
             if person.is_target:
                 self._target = person.name
-            color = (0.85, 0.1, 0.1) if person.is_target else (0.15, 0.35, 0.85)
+            m = person_marker(person, i)
+            lifetime = _ns(m.lifetime)
             markers.append(
                 t["visualization_msgs/msg/Marker"](
                     header=self._header(s, MAP_FRAME),
-                    ns=person.name,
-                    id=i,
-                    type=3,  # CYLINDER
-                    action=0,  # ADD
-                    pose=self._pose(Pose2D(person.x, person.y, person.theta), z=0.85),
-                    scale=vec(x=0.5, y=0.5, z=1.7),
-                    color=t["std_msgs/msg/ColorRGBA"](r=color[0], g=color[1], b=color[2], a=0.8),
-                    lifetime=t["builtin_interfaces/msg/Duration"](sec=0, nanosec=200_000_000),
+                    ns=m.ns,
+                    id=m.id,
+                    type=m.type,
+                    action=m.action,
+                    pose=self._pose(m.pose, z=m.z),
+                    scale=vec(x=m.scale[0], y=m.scale[1], z=m.scale[2]),
+                    color=t["std_msgs/msg/ColorRGBA"](
+                        r=m.color[0], g=m.color[1], b=m.color[2], a=m.color[3]
+                    ),
+                    lifetime=t["builtin_interfaces/msg/Duration"](
+                        sec=lifetime // 10**9, nanosec=lifetime % 10**9
+                    ),
                     frame_locked=False,
                     points=[],
                     colors=[],
-                    text=f"{'target' if person.is_target else 'distractor'} "
-                    f"speed={person.speed:.3f}",
+                    text=m.text,
                     mesh_resource="",
                     mesh_use_embedded_materials=False,
                 )
@@ -644,18 +709,7 @@ def read_episode(directory: Path) -> Episode:
         people = []
         markers = by_time.get("/ground_truth/people", {}).get(ts)
         for m in markers.markers if markers is not None else []:
-            match = _PERSON_TEXT.match(m.text)
-            pose = _pose2d(m.pose)
-            people.append(
-                PersonTruth(
-                    name=m.ns,
-                    x=pose.x,
-                    y=pose.y,
-                    theta=pose.theta,
-                    speed=float(match.group(2)) if match else 0.0,
-                    is_target=bool(match and match.group(1) == "target"),
-                )
-            )
+            people.append(person_from_marker(m.ns, _pose2d(m.pose), m.text))
         cmd = by_time.get("/cmd_vel", {}).get(ts)
         col = by_time.get("/ground_truth/collisions", {}).get(ts)
         episode.truths.append(
@@ -679,6 +733,10 @@ __all__ = [
     "TRUTH_NAME",
     "Episode",
     "EpisodeRecorder",
+    "PersonMarker",
     "RecordingError",
+    "camera_in_base",
+    "person_from_marker",
+    "person_marker",
     "read_episode",
 ]

@@ -220,27 +220,34 @@ class SimRobot:
 
     def step(self) -> None:
         """Advance one control period ``1 / behavior.tick_hz``."""
-        if self._closed:
-            raise RuntimeError("the simulator is closed")
-        dt = self.substep
         for _ in range(self.substeps):
-            if self._navigating:
-                self._cmd = self.clamp(self.navigator.update(self.pose, dt, self._scan_points))
-                if self.navigator.status is not NavStatus.ACTIVE:
-                    self._navigating = False
-            self._move(dt)
-            self._localization_step(dt)
-            self.head.update(dt)
-            clear = self.mission.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
-            for walker in self.people:
-                walker.step(dt, keep_clear=(self.pose.x, self.pose.y, clear))
-            self._ticks += 1
-            self.time = self._ticks * dt
-            self._sense()
+            self.advance_substep()
         if self.options.gui:
             self._sync_bodies()
         if self.options.realtime:
             self._pace()
+
+    def advance_substep(self) -> None:
+        """Advance one sub-step (:attr:`substep` seconds, steps 1-5 of the module docstring);
+        :meth:`step` is :attr:`substeps` of these. For a caller that acts between sub-steps
+        (``pfctl sim serve-hsr`` publishes every scan and takes commands at once); it neither
+        syncs the GUI nor paces to the clock."""
+        if self._closed:
+            raise RuntimeError("the simulator is closed")
+        dt = self.substep
+        if self._navigating:
+            self._cmd = self.clamp(self.navigator.update(self.pose, dt, self._scan_points))
+            if self.navigator.status is not NavStatus.ACTIVE:
+                self._navigating = False
+        self._move(dt)
+        self._localization_step(dt)
+        self.head.update(dt)
+        clear = self.mission.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
+        for walker in self.people:
+            walker.step(dt, keep_clear=(self.pose.x, self.pose.y, clear))
+        self._ticks += 1
+        self.time = self._ticks * dt
+        self._sense()
 
     def observe(self) -> Observation:
         scan, frame = self._scan, self._frame
