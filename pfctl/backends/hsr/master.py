@@ -1,0 +1,34 @@
+"""The ROS master's XML-RPC API with a socket timeout (rospy's own calls have none: a master that
+is down or unreachable would hang a node in ``init_node``, or a watchdog in its ping)."""
+
+from __future__ import annotations
+
+import xmlrpc.client
+
+MASTER_TIMEOUT = 1.0
+"""Default socket timeout of one call to the master, seconds."""
+
+
+class _TimeoutTransport(xmlrpc.client.Transport):
+    """XML-RPC over HTTP with a socket timeout."""
+
+    def __init__(self, timeout: float) -> None:
+        super().__init__()
+        self._timeout = timeout
+
+    def make_connection(self, host):  # type: ignore[no-untyped-def]
+        conn = super().make_connection(host)
+        conn.timeout = self._timeout
+        return conn
+
+
+def master_proxy(uri: str, timeout: float = MASTER_TIMEOUT) -> xmlrpc.client.ServerProxy:
+    """A proxy to the master at ``uri`` whose calls give up after ``timeout`` seconds (they
+    raise ``OSError``, e.g. ``TimeoutError`` or ``ConnectionRefusedError``)."""
+    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
+
+
+MASTER_ERRORS = (OSError, xmlrpc.client.Error)
+"""What a call through :func:`master_proxy` raises when the master does not answer properly."""
+
+__all__ = ["MASTER_ERRORS", "MASTER_TIMEOUT", "master_proxy"]
