@@ -112,6 +112,8 @@ class EpisodeResult:
     """``until`` ended the run before ``duration``."""
     tick_seconds: list[float] = field(default_factory=list)
     """Wall time of each follower tick (not the robot's step), seconds."""
+    clock_origin: float = 0.0
+    """The robot's clock at the episode's t = 0 (ROS time on the HSR; 0 in the simulator)."""
     lost: str | None = None
     """Why the run ended early because the robot stopped answering (:class:`RobotLostError`)."""
 

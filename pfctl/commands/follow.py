@@ -392,7 +392,7 @@ def _run_hsr(
         truth = robot.ground_truth if robot.ground_truth() is not None else None
         with graceful_interrupts() as stop, _progress(console, duration, "s") as bar:
             task = bar.add_task(what, total=duration)
-            return run_episode(
+            result = run_episode(
                 mission,
                 robot,
                 profile,
@@ -405,6 +405,8 @@ def _run_hsr(
                 stop=stop,
                 until_found=until_found,
             )
+    result.clock_origin = robot.clock_origin
+    return result
 
 
 def _end(result: EpisodeResult) -> None:
@@ -442,6 +444,7 @@ def _follow_json(
         wall_time_s=round(result.wall_time, 3),
         interrupted=result.interrupted,
         lost=result.lost,
+        clock_origin_s=result.clock_origin,
         tick_ms_median=round(float(np.median(ticks)), 3) if len(ticks) else None,
         tick_ms_p99=round(float(np.percentile(ticks, 99)), 3) if len(ticks) else None,
     )

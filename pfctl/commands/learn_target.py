@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import io
 import math
+import sys
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,7 +52,7 @@ from pfctl.core.identity import (
     describe,
     learn_profile,
 )
-from pfctl.core.robot import STOP, HeadTarget, Pose2D, RgbdFrame, Robot
+from pfctl.core.robot import STOP, HeadTarget, Pose2D, RgbdFrame, Robot, RobotLostError
 from pfctl.core.vision import HogPersonDetector, PersonDetection, PersonDetector, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
@@ -185,9 +186,11 @@ def learn_on_robot(
     simulated house served over ROS), for ``seconds`` of the robot's clock ``now()``: the base
     stands still, the head looks straight ahead and nods between a face at
     :data:`FACE_HEIGHT` and a body at :data:`BODY_HEIGHT`; the person is the detection nearest
-    the spot in front of the robot (within :data:`SPOT_RADIUS`)."""
+    the spot in front of the robot (within :data:`SPOT_RADIUS`). The frames are kept and learned
+    from once the robot has been told to stand still for good: a face embedding (~0.1 s, holding
+    the interpreter) must not starve the robot's message threads while its watchdog runs."""
     learned = Learned([])
-    encoder = FaceEncoder(params.face)
+    frames: list[RgbdFrame] = []
     start = now()
     first = robot.observe()
     spot = first.pose.compose(Pose2D(STAND_DISTANCE, 0.0))
@@ -200,8 +203,11 @@ def learn_on_robot(
         progress.update(task, advance=1)
         frame = robot.observe().rgbd
         if frame is not None:
-            _learn_frame(learned, frame, detector, (spot.x, spot.y), params, encoder)
+            frames.append(frame)
     robot.command(STOP)
+    encoder = FaceEncoder(params.face)
+    for frame in frames:
+        _learn_frame(learned, frame, detector, (spot.x, spot.y), params, encoder)
     return learned
 
 
@@ -217,16 +223,20 @@ def _learn_on_hsr(
             raise UserError(
                 "backend.hsr.person_labels: is null, so the robot detects no one to learn"
             )
-        return learn_on_robot(
-            robot,
-            detector,
-            seconds,
-            mission.behavior.tick_hz,
-            params,
-            progress,
-            now=lambda: robot.time,
-            camera_height=mission.sensors.camera.mount_height,
-        )
+        try:
+            return learn_on_robot(
+                robot,
+                detector,
+                seconds,
+                mission.behavior.tick_hz,
+                params,
+                progress,
+                now=lambda: robot.time,
+                camera_height=mission.sensors.camera.mount_height,
+            )
+        except RobotLostError as err:
+            sys.stderr.write(f"pfctl: error: {err}; the base was stopped, nothing written\n")
+            raise typer.Exit(1) from None
 
 
 def _learn_frame(

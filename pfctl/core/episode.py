@@ -88,9 +88,9 @@ class EpisodeLog:
     target_name: str | None = None
     """The scenario's target (simulator), for the metrics."""
     tracks: list[TrackRow] = field(default_factory=list)
-    """After each tick with a laser scan, one row per confirmed track seen then (coasting ones
-    are left out), stamped with the scan: what ``pfctl replay`` writes for a bag
-    (:func:`pfctl.core.perception.track_rows`)."""
+    """After each laser scan a tick fed to the perception (before its camera frame), one row per
+    confirmed track seen then (coasting ones are left out), stamped with the scan: what
+    ``pfctl replay`` writes after each scan of a bag (:func:`pfctl.core.perception.track_rows`)."""
 
 
 __all__ = [

@@ -141,8 +141,6 @@ class Follower:
         now = obs.stamp
         self._now = now
         self._perceive(obs)
-        if obs.scan is not None:
-            self.log.tracks += self.perception.seen_track_rows(obs.scan.stamp)
         target = self._target_state(now)
         visible = target is not None and now - target.last_detected <= self.params.visible_age
         self._update_sightings(now, target, visible)
@@ -162,8 +160,14 @@ class Follower:
         return record
 
     def _perceive(self, obs: Observation) -> None:
-        self.perception.on_observation(obs)
+        """Feed the scan (then log the tracks it leaves, as ``pfctl replay`` does after each
+        scan of a bag) and the frame to the perception; update the occupancy grid (Eq. 1)."""
         scan = obs.scan
+        if scan is not None:
+            self.perception.on_scan(scan)
+            self.log.tracks += self.perception.seen_track_rows(scan.stamp)
+        if obs.rgbd is not None:
+            self.perception.on_frame(obs.rgbd)
         if scan is not None:
             self._last_scan_stamp = scan.stamp
             self.grid.update_scan(

@@ -240,6 +240,7 @@ class HsrRobot:
         self._warned: set[str] = set()
         self._t0_ns = 0
         self._last_ns = 0
+        self._clock_started = False
         self._last_pose = Pose2D(0.0, 0.0, 0.0)
 
         try:
@@ -497,6 +498,7 @@ class HsrRobot:
             )
         now_ns = self._now_ns()
         self._t0_ns = self._last_ns = now_ns
+        self._clock_started = False
         self._laser_connected = self._live_publishers() > 0
         self._poll_pose(time.monotonic())
         self._last_pose = self._pose() if cfg.pose is None else self._last_pose
@@ -537,8 +539,15 @@ class HsrRobot:
 
     @property
     def time(self) -> float:
-        """Seconds of ROS time since the robot was opened (the episode clock)."""
+        """Seconds of ROS time since the first :meth:`observe` (the episode clock; before it,
+        since the robot connected)."""
         return (self._now_ns() - self._t0_ns) * 1e-9
+
+    @property
+    def clock_origin(self) -> float:
+        """The ROS time (s) of the episode clock's 0: a stamp in the robot's messages (and in a
+        bag recorded from them) is ``clock_origin +`` the episode time the follower logs."""
+        return self._t0_ns * 1e-9
 
     def _episode(self, stamp: Any) -> float:
         """A ROS stamp as episode seconds."""
@@ -835,6 +844,11 @@ class HsrRobot:
         odometry and collisions; stamps on the episode clock."""
         self._check_open()
         self._check()
+        if not self._clock_started:
+            # the episode starts at the first observation, not when the robot connected: the
+            # caller may take seconds to get ready (face models, maps) in between
+            self._clock_started = True
+            self._t0_ns = self._last_ns = self._now_ns()
         try:
             scan = self._take_scan()
             frame = self._take_frame()
