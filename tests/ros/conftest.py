@@ -29,6 +29,7 @@ from types import ModuleType
 
 import pytest
 
+from pfctl.backends.hsr.master import master_proxy as _master_proxy
 from pfctl.backends.hsr.ros_import import import_ros_module
 
 ROS_MODULES = (
@@ -59,18 +60,10 @@ def ros() -> dict[str, ModuleType]:
         pytest.skip(message)
 
 
-class _TimeoutTransport(xmlrpc.client.Transport):
-    """XML-RPC over HTTP with a socket timeout (a stuck listener must not hang the test)."""
-
-    def make_connection(self, host):  # type: ignore[no-untyped-def]
-        conn = super().make_connection(host)
-        conn.timeout = 2.0
-        return conn
-
-
 def master_proxy(uri: str) -> xmlrpc.client.ServerProxy:
-    """An XML-RPC proxy to the master at ``uri`` with a 2 s socket timeout."""
-    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport())
+    """An XML-RPC proxy to the master at ``uri`` with a 2 s socket timeout (a stuck listener
+    must not hang the test)."""
+    return _master_proxy(uri, timeout=2.0)
 
 
 @dataclass(frozen=True)

@@ -86,6 +86,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pfctl.backends.hsr import convert
+from pfctl.backends.hsr.master import master_proxy
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
@@ -149,17 +150,6 @@ def _time_class() -> Any:
 # ------------------------------------------------------------------------------------- master
 
 
-class _TimeoutTransport(xmlrpc.client.Transport):
-    def __init__(self, timeout: float) -> None:
-        super().__init__()
-        self._timeout = timeout
-
-    def make_connection(self, host):  # type: ignore[no-untyped-def]
-        conn = super().make_connection(host)
-        conn.timeout = self._timeout
-        return conn
-
-
 def master_uri() -> str:
     """``ROS_MASTER_URI``; a UserError when it is not set."""
     uri = os.environ.get("ROS_MASTER_URI", "").strip()
@@ -168,11 +158,6 @@ def master_uri() -> str:
             "ROS_MASTER_URI is not set: start a ROS master (roscore) and point ROS_MASTER_URI at it"
         )
     return uri
-
-
-def master_proxy(uri: str, timeout: float = MASTER_TIMEOUT) -> xmlrpc.client.ServerProxy:
-    """An XML-RPC proxy to the master with a socket timeout (rospy's has none)."""
-    return xmlrpc.client.ServerProxy(uri, transport=_TimeoutTransport(timeout))
 
 
 def check_master(uri: str, timeout: float = MASTER_TIMEOUT) -> None:
