@@ -628,11 +628,6 @@ def main() -> int:
     parser.add_argument(
         "--no-pace", action="store_true", help="do not sleep to the tick rate between ticks"
     )
-    parser.add_argument(
-        "--no-retain",
-        action="store_true",
-        help="leave glibc's malloc as it is (default: pfctl.core.allocation.retain_freed_memory)",
-    )
     args = parser.parse_args()
 
     if not args.mission.is_file():
@@ -664,13 +659,10 @@ def main() -> int:
 
     mode = Mode(sync=args.sync, timing=args.timing, pace=not args.no_pace)
     print(f"  mode    : {mode.describe()}")
-    if args.no_retain:
-        print("  memory  : glibc's default malloc (freed large blocks unmapped)")
-    else:
-        from pfctl.core.allocation import retain_freed_memory
+    from pfctl.core.allocation import retain_freed_memory
 
-        kept = retain_freed_memory()
-        print(f"  memory  : freed blocks kept in the heap (retain_freed_memory: {kept})")
+    kept = retain_freed_memory()  # as run_follower does for every episode
+    print(f"  memory  : freed blocks kept in the heap (retain_freed_memory: {kept})")
     clock = TickClock()
     try:
         result, seed, worker, pacer = run_once(

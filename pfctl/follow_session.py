@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from pfctl.core.allocation import retain_freed_memory
 from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.control import ControlParams
 from pfctl.core.episode import EpisodeLog, TickRecord
@@ -136,6 +137,7 @@ def run_follower(
     stopped) at the end."""
     import time
 
+    retain_freed_memory()  # the next tick reuses this tick's pages (no page faults per tick)
     result = EpisodeResult(follower.log)
     start = time.perf_counter()
     try:

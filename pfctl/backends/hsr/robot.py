@@ -539,9 +539,18 @@ class HsrRobot:
 
     @property
     def time(self) -> float:
-        """Seconds of ROS time since the first :meth:`observe` (the episode clock; before it,
-        since the robot connected)."""
+        """Seconds of ROS time since the episode started: 0 until the caller first observes,
+        steps or commands the robot (not when it connected: a caller may take seconds to get
+        ready — face models, maps — in between), then the episode clock."""
+        if not self._clock_started:
+            return 0.0
         return (self._now_ns() - self._t0_ns) * 1e-9
+
+    def _start_clock(self) -> None:
+        """Start the episode clock now, the first time the robot is used."""
+        if not self._clock_started:
+            self._clock_started = True
+            self._t0_ns = self._last_ns = max(self._last_ns, self._now_ns())
 
     @property
     def clock_origin(self) -> float:
@@ -714,6 +723,7 @@ class HsrRobot:
     def command(self, base: Twist2D, head: HeadTarget | None = None) -> None:
         """Publish the clamped base velocity (zero while the data are stale or the robot is
         lost); a direct command cancels an active navigation goal (PREEMPTED)."""
+        self._start_clock()
         if self._closed:
             return
         self._arm()
@@ -730,6 +740,7 @@ class HsrRobot:
     def point_head(self, head: HeadTarget) -> None:
         """Send the head toward ``head`` (clamped to the joint limits) in the time the head
         needs at ``robot.head_max_speed``, at least one control period."""
+        self._start_clock()
         if self._closed or self._lost is not None:
             return
         self._arm()
@@ -758,6 +769,7 @@ class HsrRobot:
     def navigate(self, goal: Pose2D) -> None:
         """Send ``goal`` (map frame) to move_base; ABORTED at once (with a warning) when there
         is no action server or the robot is lost."""
+        self._start_clock()
         if self._closed or self._lost is not None:
             self._nav_local = NavStatus.ABORTED
             return
@@ -805,6 +817,7 @@ class HsrRobot:
         """Wait until the next multiple of the control period on the episode clock (sim time
         under ``/clock``). Raises :class:`RobotLostError` when the robot is lost meanwhile, or
         when ``/clock`` stops for ``stale_timeout`` wall seconds."""
+        self._start_clock()
         self._check_open()
         self._arm()
         try:
@@ -844,11 +857,7 @@ class HsrRobot:
         odometry and collisions; stamps on the episode clock."""
         self._check_open()
         self._check()
-        if not self._clock_started:
-            # the episode starts at the first observation, not when the robot connected: the
-            # caller may take seconds to get ready (face models, maps) in between
-            self._clock_started = True
-            self._t0_ns = self._last_ns = self._now_ns()
+        self._start_clock()
         try:
             scan = self._take_scan()
             frame = self._take_frame()
