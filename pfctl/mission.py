@@ -78,6 +78,7 @@ __all__ = [
     "Retry",
     "RobotConfig",
     "ScenarioConfig",
+    "ScenarioRandomization",
     "SearchConfig",
     "SensorModel",
     "SensorsConfig",
@@ -956,6 +957,56 @@ class Person(_Model):
     """Walk the route again and again (back to the first stop); else stay at the last stop."""
 
 
+PeopleCount = Annotated[int, Field(ge=0, le=20), _NO_BOOL]
+
+
+def _check_range(value: tuple[Any, Any]) -> tuple[Any, Any]:
+    """A ``[low, high]`` range must have ``low <= high`` (equal: a fixed value)."""
+    if value[0] > value[1]:
+        raise _error(
+            "range_order", f"expected [low, high] with low <= high, got [{value[0]}, {value[1]}]"
+        )
+    return value
+
+
+CountRange = Annotated[tuple[PeopleCount, PeopleCount], AfterValidator(_check_range)]
+"""An inclusive ``[low, high]`` range of a number of people, each drawn uniformly."""
+ScaleRange = Annotated[
+    tuple[
+        Annotated[float, Field(ge=0.25, le=4.0), _NO_BOOL],
+        Annotated[float, Field(ge=0.25, le=4.0), _NO_BOOL],
+    ],
+    AfterValidator(_check_range),
+]
+"""A ``[low, high]`` range of a factor, drawn uniformly."""
+
+
+class ScenarioRandomization(_Model):
+    """What else the seed varies from episode to episode (``pfctl bench`` campaigns).
+
+    Everything is off by default, so a mission without this section runs exactly as before. The
+    draws come from their own random streams of the seed: turning one on leaves everything the
+    seed already varied (region stops, pauses, ``random_people``, faces, sensor noise) as it was.
+    """
+
+    speed_scale: ScaleRange = (1.0, 1.0)
+    """Each of ``people`` walks at their ``speed`` times a factor drawn from this range (the
+    result kept within a person's 0.3-1.4 m/s)."""
+    route_jitter: NonNegative = 0.0
+    """Each ``[x, y]`` stop of the ``people``'s routes moves by up to this many metres, to a
+    free spot of the same region (region stops are already a random free point of the region)."""
+    extra_people: CountRange = (0, 0)
+    """Distractors added to ``random_people``: their number drawn from this range."""
+    look_alikes: CountRange = (0, 0)
+    """Distractors dressed like the target (each colour channel within ``look_alike_jitter``),
+    walking random looping routes: their number drawn from this range."""
+    look_alike_jitter: Annotated[int, Field(ge=0, le=128), _NO_BOOL] = 12
+    """How far a look-alike's clothes may stray from the target's, per RGB channel (0..255)."""
+    hide_in: tuple[Name, ...] = ()
+    """``pfctl search``/``bench --task search``: the target hides in one of these regions, chosen
+    by the seed (empty: any region that is not the robot's or next to it)."""
+
+
 class ScenarioConfig(_Model):
     """The simulator's episode: seed, the people, and which of them is the target."""
 
@@ -963,8 +1014,10 @@ class ScenarioConfig(_Model):
     target: str | None = None
     """The name of the person to follow: one of ``people``."""
     people: tuple[Person, ...] = ()
-    random_people: Annotated[int, Field(ge=0, le=20), _NO_BOOL] = 0
+    random_people: PeopleCount = 0
     """Extra distractors with random clothes, speeds and looping routes drawn from ``seed``."""
+    randomize: ScenarioRandomization = ScenarioRandomization()
+    """Further per-seed variation for benchmark campaigns; all off by default."""
 
     @model_validator(mode="after")
     def _names(self) -> ScenarioConfig:
@@ -986,6 +1039,13 @@ class ScenarioConfig(_Model):
                 (
                     ("target",),
                     f"expected the name of one of the people ({names}), got {self.target!r}",
+                )
+            )
+        if self.target is None and self.randomize.look_alikes[1] > 0:
+            issues.append(
+                (
+                    ("randomize", "look_alikes"),
+                    "look-alikes copy the target's clothes: name a scenario.target first",
                 )
             )
         _raise_first(issues)
@@ -1106,6 +1166,14 @@ class Mission(_Model):
                     issues.append(
                         (loc, f"expected a point inside the regions, got {_fmt_point(stop)}")
                     )
+        for i, region in enumerate(self.scenario.randomize.hide_in):
+            if region not in regions:
+                issues.append(
+                    (
+                        ("scenario", "randomize", "hide_in", i),
+                        f"unknown region {region!r} (regions: {', '.join(regions)})",
+                    )
+                )
         _raise_first(issues)
         return self
 

@@ -552,8 +552,9 @@ def search(
 
 
 def hide_target(robot: SimRobot, region: str | None) -> str:
-    """Put the scenario's target at a free spot of ``region`` (None: a region other than the
-    robot's, chosen by the seed), standing still, out of the robot's view; the region used."""
+    """Put the scenario's target at a free spot of ``region`` (None: one of the mission's
+    ``scenario.randomize.hide_in``, else a region other than the robot's and its neighbours,
+    chosen by the seed), standing still, out of the robot's view; the region used."""
     from pfctl.backends.pybullet.walkers import PERSON_RADIUS
     from pfctl.core.regions import RegionMap
 
@@ -565,6 +566,9 @@ def hide_target(robot: SimRobot, region: str | None) -> str:
     rng = np.random.default_rng([robot.seed, 99])
     here = regions.locate((robot.pose.x, robot.pose.y))
     choices = [n for n in regions.names if n != here and n not in regions.neighbours(here or "")]
+    hide_in = list(mission.scenario.randomize.hide_in)
+    if hide_in:
+        choices = [n for n in hide_in if n != here] or hide_in
     if region is None:
         choices = choices or [n for n in regions.names if n != here]
         region = choices[int(rng.integers(len(choices)))]

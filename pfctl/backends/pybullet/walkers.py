@@ -34,6 +34,10 @@ HIP_WIDTH = 0.2
 ACCELERATION = 0.6
 #: Fastest turn of the body, rad/s.
 TURN_RATE = 3.0
+#: A person's walking speed limits (``scenario.people[*].speed``), m/s.
+MIN_SPEED, MAX_SPEED = 0.3, 1.4
+#: The first word of the seeds of ``scenario.randomize``'s random streams.
+RANDOMIZE = 7919
 
 
 @dataclass(frozen=True)
@@ -263,9 +267,14 @@ class Walker:
 
 
 def _stops(
-    mission: Mission, person: Person, planner: GridPlanner, rng: np.random.Generator
+    mission: Mission,
+    person: Person,
+    planner: GridPlanner,
+    rng: np.random.Generator,
+    jitter_rng: np.random.Generator | None = None,
 ) -> list[np.ndarray]:
     layout = mission.layout()
+    jitter = mission.scenario.randomize.route_jitter
     out = []
     for stop in person.route:
         if isinstance(stop, str):
@@ -274,28 +283,66 @@ def _stops(
             p = planner.nearest_free(stop, max_distance=1.0)
             if p is None:
                 raise NoPathError(f"{person.name}: route point {stop} is not free for a person")
-            out.append(np.asarray(p, dtype=float))
+            point = np.asarray(p, dtype=float)
+            if jitter > 0 and jitter_rng is not None:
+                point = _jittered(mission, planner, point, jitter, jitter_rng)
+            out.append(point)
     return out
 
 
+def _jittered(
+    mission: Mission,
+    planner: GridPlanner,
+    point: np.ndarray,
+    jitter: float,
+    rng: np.random.Generator,
+    tries: int = 20,
+) -> np.ndarray:
+    """``point`` moved by up to ``jitter`` metres (uniform over the disc) to a free spot of the
+    same region (``scenario.randomize.route_jitter``); ``point`` itself if no draw lands there."""
+    regions = [shapely.Polygon(r.polygon) for r in mission.layout().regions]
+    home = next((r for r in regions if r.covers(shapely.Point(point))), None)
+    for _ in range(tries):
+        r = jitter * math.sqrt(float(rng.uniform()))
+        a = float(rng.uniform(-math.pi, math.pi))
+        q = point + r * np.array([math.cos(a), math.sin(a)])
+        if planner.is_free(q) and (home is None or home.contains(shapely.Point(q))):
+            return q
+    return point
+
+
 def _random_walkers(
-    mission: Mission, planner: GridPlanner, rng: np.random.Generator, taken: set[str]
+    mission: Mission,
+    planner: GridPlanner,
+    rng: np.random.Generator,
+    taken: set[str],
+    count: int | None = None,
+    *,
+    prefix: str = "walker",
+    dress_like: WalkerClothes | None = None,
+    jitter: int = 0,
 ) -> list[Walker]:
-    """``scenario.random_people`` distractors: random free stops, clothes and speed."""
+    """``count`` (default ``scenario.random_people``) distractors: random free stops, clothes
+    and speed; with ``dress_like``, clothes within ``jitter`` of those per RGB channel."""
     layout = mission.layout()
     walkers = []
-    for i in range(mission.scenario.random_people):
-        name = f"walker_{i}"
+    for i in range(mission.scenario.random_people if count is None else count):
+        name = f"{prefix}_{i}"
         while name in taken:
             name += "_"
         regions = rng.choice(len(layout.regions), size=3, replace=True)
         stops = []
         for r in regions:
             stops.append(_region_point(planner, layout.regions[int(r)].polygon, rng))
-        clothes = WalkerClothes(
-            tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
-            tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
-        )
+        if dress_like is None:
+            clothes = WalkerClothes(
+                tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
+                tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
+            )
+        else:
+            clothes = WalkerClothes(
+                _near(dress_like.upper, jitter, rng), _near(dress_like.lower, jitter, rng)
+            )
         walkers.append(
             Walker(
                 name,
@@ -313,7 +360,9 @@ def _random_walkers(
 
 
 def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
-    """The scenario's people (plus ``random_people`` distractors), deterministic for ``seed``.
+    """The scenario's people (plus ``random_people`` distractors, and what
+    ``scenario.randomize`` adds: speeds, moved route points, extra distractors and look-alikes
+    dressed like the target), deterministic for ``seed``.
 
     ``planner`` may be the robot's: routes are planned with a copy for :data:`PERSON_RADIUS`.
     Raises :class:`NoPathError` if a route cannot be walked.
@@ -321,18 +370,27 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
     if abs(planner.robot_radius - PERSON_RADIUS) > 1e-9:
         planner = planner.with_radius(PERSON_RADIUS)
     rng = np.random.default_rng(seed)
+    vary = mission.scenario.randomize
+    # scenario.randomize draws from streams of its own: the draws above stay as they were
+    speed_rng, jitter_rng, extra_rng = (
+        np.random.default_rng([seed, RANDOMIZE, k]) for k in range(3)
+    )
     walkers = []
     for person in mission.scenario.people:
         clothes = WalkerClothes(
             tuple(int(v) for v in person.clothes.upper),  # type: ignore[arg-type]
             tuple(int(v) for v in person.clothes.lower),  # type: ignore[arg-type]
         )
+        speed = person.speed
+        if vary.speed_scale != (1.0, 1.0):
+            scale = float(speed_rng.uniform(*vary.speed_scale))
+            speed = min(MAX_SPEED, max(MIN_SPEED, speed * scale))
         walkers.append(
             Walker(
                 person.name,
-                _stops(mission, person, planner, rng),
+                _stops(mission, person, planner, rng, jitter_rng),
                 planner,
-                speed=person.speed,
+                speed=speed,
                 clothes=clothes,
                 height=person.height,
                 pause_s=person.pause_s,
@@ -342,7 +400,30 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
             )
         )
     walkers += _random_walkers(mission, planner, rng, {w.name for w in walkers})
+    extra = int(extra_rng.integers(vary.extra_people[0], vary.extra_people[1] + 1))
+    alikes = int(extra_rng.integers(vary.look_alikes[0], vary.look_alikes[1] + 1))
+    if extra:
+        taken = {w.name for w in walkers}
+        walkers += _random_walkers(mission, planner, extra_rng, taken, extra, prefix="extra")
+    target = next((w for w in walkers if w.is_target), None)
+    if alikes and target is not None:
+        walkers += _random_walkers(
+            mission,
+            planner,
+            extra_rng,
+            {w.name for w in walkers},
+            alikes,
+            prefix="look_alike",
+            dress_like=target.clothes,
+            jitter=vary.look_alike_jitter,
+        )
     return walkers
+
+
+def _near(rgb: tuple[int, int, int], jitter: int, rng: np.random.Generator) -> tuple[int, int, int]:
+    """``rgb`` with each channel moved by up to ``jitter`` (uniform integers), kept in 0..255."""
+    moved = np.asarray(rgb) + rng.integers(-jitter, jitter + 1, 3)
+    return tuple(int(v) for v in np.clip(moved, 0, 255))  # type: ignore[return-value]
 
 
 __all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerClothes", "WalkerState", "make_walkers"]
