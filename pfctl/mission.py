@@ -8,13 +8,16 @@ whose fields are SI values.
 A mission is checked in three layers, and every failure becomes a :class:`pfctl.errors.MissionError`
 whose message is one line, ``<file>:<line>: <key.path[2].sub>: <what was expected>``:
 
-1. reading: missing file, a directory, not UTF-8, empty, YAML syntax, duplicate keys;
+1. reading: missing file, a directory, not UTF-8, empty, YAML syntax, duplicate keys; the
+   mission it ``extends`` (read first, this file merged over it: :func:`merge_mission_data`)
+   and a tree file it includes (``behavior.tree: {include: PATH}``), missing or in a cycle;
 2. shape: unknown keys, wrong types, ranges (pydantic, ``extra="forbid"`` everywhere);
 3. meaning: polygons are simple with >= 3 distinct points, regions do not overlap, doors lie on
    the wall two existing regions share, the scenario's target and routes name existing things.
 
 The line is found by composing the YAML node graph and walking it along the error's key path to
-the deepest node that exists.
+the deepest node that exists. A mission merged with the one it extends has one node graph merged
+the same way, each node marked with the file it came from, so the error names that file.
 
 Example::
 
@@ -25,6 +28,7 @@ Example::
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import re
@@ -90,6 +94,7 @@ __all__ = [
     "dump_json_schema",
     "load_mission",
     "loads_mission",
+    "merge_mission_data",
 ]
 
 #: Geometric tolerance of the semantic checks, metres (and m² for areas).
@@ -1226,29 +1231,21 @@ def dump_json_schema() -> dict[str, Any]:
 def load_mission(path: str | os.PathLike[str]) -> Mission:
     """Read and validate the mission at ``path``.
 
+    A mission may start from another: a top-level ``extends: PATH`` (relative to the file)
+    loads that mission's YAML first — recursively, a cycle is an error — and merges this file
+    over it (:func:`merge_mission_data`). ``behavior.tree: {include: PATH}`` reads the tree from
+    a file holding exactly what ``behavior.tree`` would (``missions/trees/``). Relative paths in
+    a file (``map.occupancy``, ``perception.legs.model``) stay relative to the file that has
+    them, and errors name the file and line the failing value came from.
+
     Raises:
         MissionError: for anything wrong with the file, with a one-line message
             ``<file>:<line>: <key.path>: <what was expected>``.
     """
     source = os.fspath(path)
     file = Path(source)
-    if file.is_dir():
-        raise MissionError(f"{source}: is a directory, expected a mission YAML file")
-    try:
-        raw = file.read_bytes()
-    except FileNotFoundError:
-        raise MissionError(f"{source}: no such file") from None
-    except OSError as err:
-        raise MissionError(f"{source}: cannot read: {err.strerror or err}") from None
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError as err:
-        line = raw[: err.start].count(b"\n") + 1
-        raise MissionError(
-            f"{source}:{line}: not UTF-8 text (byte 0x{raw[err.start]:02x}); "
-            "save the mission as UTF-8"
-        ) from None
-    return loads_mission(text, source=source, base_dir=file.parent)
+    text = _read_text(file, source, "a mission YAML file")
+    return _loads(text, source, file.parent, ((file.resolve(), source),))
 
 
 def loads_mission(
@@ -1256,30 +1253,240 @@ def loads_mission(
 ) -> Mission:
     """Validate the mission YAML in ``text``; ``source`` names it in errors.
 
-    ``base_dir`` is where relative paths in the mission (``map.occupancy``) are resolved;
-    the current directory if None.
+    ``base_dir`` is where relative paths in the mission (``map.occupancy``, ``extends``,
+    ``behavior.tree.include``) are resolved; the current directory if None.
 
     Raises:
         MissionError: as :func:`load_mission`.
     """
+    return _loads(text, source, Path(base_dir) if base_dir is not None else Path("."), ())
+
+
+def merge_mission_data(base: Any, child: Any, path: tuple[str, ...] = ()) -> Any:
+    """``child`` deep-merged over ``base`` (the semantics of ``extends``).
+
+    Mappings merge key by key (a key of ``child`` wins; keys only in ``base`` stay); lists and
+    scalars replace. ``behavior.tree`` replaces as a whole: a tree node is one of several kinds,
+    and merging two trees would mix them. ``path`` is the key path of ``base`` and ``child``.
+    """
+    if isinstance(base, dict) and isinstance(child, dict) and path != _TREE_PATH:
+        merged = dict(base)
+        for key, value in child.items():
+            sub = (*path, str(key))
+            merged[key] = merge_mission_data(base[key], value, sub) if key in base else value
+        return merged
+    return child
+
+
+#: The top-level key naming the mission a file extends.
+EXTENDS_KEY = "extends"
+#: ``behavior.tree: {include: PATH}``: the tree is read from PATH.
+INCLUDE_KEY = "include"
+_TREE_PATH = ("behavior", "tree")
+_Chain = tuple[tuple[Path, str], ...]
+"""The files being extended, outermost first: (resolved path, name in messages)."""
+
+
+def _read_text(file: Path, source: str, what: str) -> str:
+    """The UTF-8 text of ``file``; one-line errors naming ``source``."""
+    if file.is_dir():
+        raise MissionError(f"{source}: is a directory, expected {what}")
+    try:
+        raw = file.read_bytes()
+    except FileNotFoundError:
+        raise MissionError(f"{source}: no such file") from None
+    except OSError as err:
+        raise MissionError(f"{source}: cannot read: {err.strerror or err}") from None
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError as err:
+        line = raw[: err.start].count(b"\n") + 1
+        raise MissionError(
+            f"{source}:{line}: not UTF-8 text (byte 0x{raw[err.start]:02x}); "
+            "save the mission as UTF-8"
+        ) from None
+
+
+def _loads(text: str, source: str, base_dir: Path, chain: _Chain) -> Mission:
+    """Read ``text`` with what it extends and includes, then validate the merged mission."""
+    root, data, sources = _read_layers(text, source, base_dir, chain)
+    context = {"base_dir": base_dir}
+    try:
+        return Mission.model_validate(data, context=context)
+    except ValidationError as err:
+        raise MissionError(_format_validation_error(err, root, sources)) from None
+    except RecursionError:
+        raise MissionError(f"{source}: the mission is nested too deeply") from None
+
+
+def _read_layers(
+    text: str, source: str, base_dir: Path, chain: _Chain
+) -> tuple[yaml.MappingNode, dict[str, Any], list[str]]:
+    """The mission in ``text`` merged over the one it extends: the YAML node graph (every node
+    keeps the name of its file in its marks, for error lines), the data, and the files read,
+    this one first."""
     root, data = _parse_yaml(text, source)
     if root is None or data is None:
         raise MissionError(
             f"{source}: the file is empty; expected a mission with at least 'name' and 'map'"
         )
-    if not isinstance(data, dict):
+    if not isinstance(data, dict) or not isinstance(root, yaml.MappingNode):
         raise MissionError(
             f"{source}:{root.start_mark.line + 1}: expected a mapping of mission sections "
             f"(name, map, ...) at the top level, got {_yaml_kind(data)}"
         )
     _check_duplicate_keys(root, source)
-    context = {"base_dir": Path(base_dir) if base_dir is not None else Path(".")}
-    try:
-        return Mission.model_validate(data, context=context)
-    except ValidationError as err:
-        raise MissionError(_format_validation_error(err, root, source)) from None
-    except RecursionError:
-        raise MissionError(f"{source}: the mission is nested too deeply") from None
+    sources = [source, *_include_tree(root, data, source, base_dir)]
+    key = _key_node(root, EXTENDS_KEY)
+    if key is None:
+        return root, data, sources
+    line = key.start_mark.line + 1
+    where = f"{source}:{line}: {EXTENDS_KEY}"
+    value = data.pop(EXTENDS_KEY)
+    root = yaml.MappingNode(
+        root.tag,
+        [(k, v) for k, v in root.value if k is not key],
+        root.start_mark,
+        root.end_mark,
+        root.flow_style,
+    )
+    if not isinstance(value, str) or not value.strip():
+        raise MissionError(
+            f"{where}: expected the path of the mission this one extends (relative to this "
+            f"file), got {_got(value)}"
+        )
+    base_file = Path(value) if Path(value).is_absolute() else base_dir / value
+    if not base_file.is_file():
+        raise MissionError(
+            f"{where}: expected an existing mission file, but {os.path.normpath(base_file)} "
+            + ("is a directory" if base_file.is_dir() else "does not exist")
+        )
+    resolved = base_file.resolve()
+    names = [name for _, name in chain] or [source]
+    if any(resolved == seen for seen, _ in chain):
+        cycle = " -> ".join([*names, os.path.normpath(base_file)])
+        raise MissionError(f"{where}: a mission cannot extend itself: {cycle}")
+    base_name = os.path.normpath(base_file)  # for messages; the file is read as written
+    base_text = _read_text(base_file, base_name, "a mission YAML file")
+    base_chain = (*(chain or ((Path(source), source),)), (resolved, base_name))
+    base_root, base_data, base_sources = _read_layers(
+        base_text, base_name, base_file.parent, base_chain
+    )
+    _rebase_files(base_data, base_file.parent, base_dir)
+    merged_root = _merge_nodes(base_root, root, ())
+    assert isinstance(merged_root, yaml.MappingNode)
+    return merged_root, merge_mission_data(base_data, data), [*sources, *base_sources]
+
+
+def _key_node(node: yaml.Node, key: str) -> yaml.ScalarNode | None:
+    """The key node ``key`` of mapping ``node`` (the last, as PyYAML keeps), else None."""
+    if not isinstance(node, yaml.MappingNode):
+        return None
+    for k, _ in reversed(node.value):
+        if isinstance(k, yaml.ScalarNode) and k.value == key:
+            return k
+    return None
+
+
+def _include_tree(
+    root: yaml.MappingNode, data: dict[str, Any], source: str, base_dir: Path
+) -> list[str]:
+    """Replace ``behavior.tree: {include: PATH}`` by the tree read from PATH (relative to the
+    mission file), in the data and in the node graph; the file read, if any."""
+    behavior, tree = data.get("behavior"), None
+    if isinstance(behavior, dict):
+        tree = behavior.get("tree")
+    if not isinstance(tree, dict) or INCLUDE_KEY not in tree:
+        return []
+    behavior_value = next(v for k, v in root.value if k is _key_node(root, "behavior"))
+    tree_key = _key_node(behavior_value, "tree")
+    assert tree_key is not None and isinstance(behavior_value, yaml.MappingNode)
+    tree_value = next(v for k, v in behavior_value.value if k is tree_key)
+    include_key = _key_node(tree_value, INCLUDE_KEY)
+    assert include_key is not None
+    where = f"{source}:{include_key.start_mark.line + 1}: behavior.tree.{INCLUDE_KEY}"
+    others = [str(k) for k in tree if k != INCLUDE_KEY]
+    if others:
+        raise MissionError(
+            f"{where}: a tree read from a file takes no other keys, got {others[0]!r} beside it"
+        )
+    value = tree[INCLUDE_KEY]
+    if not isinstance(value, str) or not value.strip():
+        raise MissionError(
+            f"{where}: expected the path of a tree file (relative to this file), got {_got(value)}"
+        )
+    file = Path(value) if Path(value).is_absolute() else base_dir / value
+    if not file.is_file():
+        raise MissionError(
+            f"{where}: expected an existing tree file, but {os.path.normpath(file)} "
+            + ("is a directory" if file.is_dir() else "does not exist")
+        )
+    name = os.path.normpath(file)
+    tree_root, tree_data = _parse_yaml(_read_text(file, name, "a behavior-tree YAML file"), name)
+    if tree_root is None or tree_data is None:
+        raise MissionError(
+            f"{name}: the file is empty; expected a behavior tree (what behavior.tree holds)"
+        )
+    _check_duplicate_keys(tree_root, name, _TREE_PATH)
+    behavior["tree"] = tree_data
+    behavior_value.value = [(k, tree_root if k is tree_key else v) for k, v in behavior_value.value]
+    return [name]
+
+
+def _merge_nodes(base: yaml.Node, child: yaml.Node, path: tuple[str, ...]) -> yaml.Node:
+    """:func:`merge_mission_data` on the YAML node graphs: a merged mapping takes the child's
+    marks; every other node stays the one (and the file) its value came from."""
+    if not (
+        isinstance(base, yaml.MappingNode)
+        and isinstance(child, yaml.MappingNode)
+        and path != _TREE_PATH
+    ):
+        return child
+    children = {k.value: (k, v) for k, v in child.value if isinstance(k, yaml.ScalarNode)}
+    merged: list[tuple[yaml.Node, yaml.Node]] = []
+    for k, v in base.value:
+        name = k.value if isinstance(k, yaml.ScalarNode) else None
+        if name in children:
+            ck, cv = children.pop(name)
+            merged.append((ck, _merge_nodes(v, cv, (*path, name))))
+        else:
+            merged.append((k, v))
+    merged += [
+        (k, v) for k, v in child.value if not isinstance(k, yaml.ScalarNode) or k.value in children
+    ]
+    return yaml.MappingNode(child.tag, merged, child.start_mark, child.end_mark, child.flow_style)
+
+
+@functools.cache
+def _file_fields() -> tuple[tuple[str, ...], ...]:
+    """Key paths of the mission's file-valued fields (``map.occupancy``,
+    ``perception.legs.model``): the ``Path`` fields of the models, through nested models."""
+
+    def walk(model: type[BaseModel], seen: frozenset[type[BaseModel]]) -> list[tuple[str, ...]]:
+        out: list[tuple[str, ...]] = []
+        for name, info in model.model_fields.items():
+            if Path in (info.annotation, *get_args(info.annotation)):
+                out.append((name,))
+            for sub in _models_in(info.annotation):
+                if sub not in seen:
+                    out += [(name, *rest) for rest in walk(sub, seen | {sub})]
+        return out
+
+    return tuple(walk(Mission, frozenset({Mission})))
+
+
+def _rebase_files(data: dict[str, Any], file_dir: Path, base_dir: Path) -> None:
+    """Relative file paths of a base mission in ``file_dir``, made absolute so that they still
+    name the same files when the extending mission in ``base_dir`` is validated."""
+    if file_dir.resolve() == base_dir.resolve():
+        return
+    for keys in _file_fields():
+        parent: Any = data
+        for key in keys[:-1]:
+            parent = parent.get(key) if isinstance(parent, dict) else None
+        value = parent.get(keys[-1]) if isinstance(parent, dict) else None
+        if isinstance(value, str) and value and not Path(value).is_absolute():
+            parent[keys[-1]] = str((file_dir / value).absolute())
 
 
 def _yaml_kind(value: Any) -> str:
@@ -1302,6 +1509,7 @@ def _short(value: Any, limit: int = 40) -> str:
 def _parse_yaml(text: str, source: str) -> tuple[yaml.Node | None, Any]:
     """Compose the node graph (for line numbers) and construct the data from it, in one parse."""
     loader = yaml.SafeLoader(text)
+    loader.name = source  # every node's marks name its file (errors of merged missions)
     try:
         root = loader.get_single_node()
         data = loader.construct_document(root) if root is not None else None
@@ -1339,10 +1547,11 @@ def _format_loc(loc: Sequence[str | int]) -> str:
     return out
 
 
-def _check_duplicate_keys(root: yaml.Node, source: str) -> None:
-    """PyYAML keeps the last of two equal keys silently; a mission must not repeat a key."""
+def _check_duplicate_keys(root: yaml.Node, source: str, prefix: tuple[str | int, ...] = ()) -> None:
+    """PyYAML keeps the last of two equal keys silently; a mission must not repeat a key.
+    ``prefix`` is the key path of ``root`` in the mission (a tree file's ``behavior.tree``)."""
     seen: set[int] = set()
-    stack: list[tuple[yaml.Node, tuple[str | int, ...]]] = [(root, ())]
+    stack: list[tuple[yaml.Node, tuple[str | int, ...]]] = [(root, prefix)]
     while stack:
         node, loc = stack.pop()
         if id(node) in seen:
@@ -1364,15 +1573,16 @@ def _check_duplicate_keys(root: yaml.Node, source: str) -> None:
             stack.extend((item, (*loc, i)) for i, item in enumerate(node.value))
 
 
-def _locate(root: yaml.Node, loc: Sequence[str | int]) -> tuple[tuple[str | int, ...], int]:
-    """Walk the node graph along ``loc``; the cleaned key path and the line of the deepest node.
+def _locate(root: yaml.Node, loc: Sequence[str | int]) -> tuple[tuple[str | int, ...], yaml.Mark]:
+    """Walk the node graph along ``loc``; the cleaned key path and the mark of the deepest node.
 
     Union tags that pydantic inserts into the path (``route[0].point``) are dropped: a string
     step into a scalar or a list cannot be a key. Once a key is missing, the rest of the path is
-    kept as is. The line is the key's line when the last step was into a mapping.
+    kept as is. The mark is the key's when the last step was into a mapping; its ``name`` is the
+    file the node was read from (a mission merged with the one it extends has nodes of both).
     """
     node: yaml.Node | None = root
-    line = root.start_mark.line + 1
+    mark = root.start_mark
     path: list[str | int] = []
     for part in loc:
         if node is None:
@@ -1390,18 +1600,18 @@ def _locate(root: yaml.Node, loc: Sequence[str | int]) -> tuple[tuple[str | int,
             if match is None:
                 node = None
             else:
-                line = match[0].start_mark.line + 1
+                mark = match[0].start_mark
                 node = match[1]
         elif isinstance(part, str):
             continue  # a union tag, not a key
         elif isinstance(node, yaml.SequenceNode) and 0 <= part < len(node.value):
             path.append(part)
             node = node.value[part]
-            line = node.start_mark.line + 1
+            mark = node.start_mark
         else:
             path.append(part)
             node = None
-    return tuple(path), line
+    return tuple(path), mark
 
 
 def _allowed_keys(loc: Sequence[str | int]) -> list[str] | None:
@@ -1471,15 +1681,15 @@ def _got(value: Any) -> str:
     return _short(value)
 
 
-def _format_error(error: Mapping[str, Any], root: yaml.Node) -> tuple[int, str, int]:
-    """One pydantic error as ``(line, "key.path: message", further errors it stands for)``."""
+def _format_error(error: Mapping[str, Any], root: yaml.Node) -> tuple[yaml.Mark, str, int]:
+    """One pydantic error as ``(mark, "key.path: message", further errors it stands for)``."""
     loc = tuple(error["loc"])
     ctx = error.get("ctx") or {}
     kind = error["type"]
     message = _one_line(error["msg"])
     if kind == "mission":
         loc = (*loc, *ctx.get("loc", ()))
-    path, line = _locate(root, loc)
+    path, mark = _locate(root, loc)
     more = int(ctx.get("more", 0)) if kind == "mission" else 0
     if kind == "missing":
         message = "required key is missing"
@@ -1509,11 +1719,13 @@ def _format_error(error: Mapping[str, Any], root: yaml.Node) -> tuple[int, str, 
         if "detail" not in ctx and kind != "route_stop" and not count:
             message += f" (got {_got(error.get('input'))})"
     where = _format_loc(path)
-    return line, f"{where}: {message}" if where else message, more
+    return mark, f"{where}: {message}" if where else message, more
 
 
-def _format_validation_error(err: ValidationError, root: yaml.Node, source: str) -> str:
-    """The first error in file order, as one line, with ``(+N more)`` when there are others."""
+def _format_validation_error(err: ValidationError, root: yaml.Node, sources: list[str]) -> str:
+    """The first error in file order — the files in ``sources`` order (the mission, then what it
+    includes and extends), then by line — as one line naming its file, with ``(+N more)`` when
+    there are others."""
     errors = err.errors()
     # A list with a bad item is also "too short after validation": that one is noise.
     errors = [
@@ -1525,8 +1737,13 @@ def _format_validation_error(err: ValidationError, root: yaml.Node, source: str)
         )
     ]
     formatted = [_format_error(e, root) for e in errors]
-    formatted.sort(key=lambda item: item[0])  # stable: equal lines keep pydantic's order
-    line, message, _ = formatted[0]
+    order = {name: i for i, name in reversed(list(enumerate(sources)))}
+
+    def position(item: tuple[yaml.Mark, str, int]) -> tuple[int, int]:
+        return (order.get(item[0].name, len(sources)), item[0].line)
+
+    formatted.sort(key=position)  # stable: equal lines keep pydantic's order
+    mark, message, _ = formatted[0]
     more = len(formatted) - 1 + sum(m for _, _, m in formatted)
     suffix = f" (+{more} more)" if more else ""
-    return f"{source}:{line}: {message}{suffix}"
+    return f"{mark.name}:{mark.line + 1}: {message}{suffix}"
