@@ -55,6 +55,7 @@ def follower_params(mission: Mission) -> FollowerParams:
             frontier_threshold=s.frontier_threshold,
             min_frontier_cells=s.min_frontier_cells,
             heading_window_s=s.heading_window_s,
+            waypoint_choice=s.waypoint_choice,
         ),
         prediction=PredictionParams(
             model=p.model,

@@ -673,6 +673,10 @@ class SearchConfig(_Model):
     """T: the pose history Algorithm 1 looks back over, s."""
     min_frontier_cells: Count = 5
     """Smaller frontier clusters are dropped."""
+    waypoint_choice: Literal["utility", "nearest"] = "utility"
+    """How Algorithm 1 picks the frontier to search: ``utility`` (Eq. 3, the paper) or
+    ``nearest`` (the reachable frontier nearest the robot by path length, whatever its size or
+    l*: the nearest-frontier baseline, ``missions/baselines/``)."""
 
 
 # --------------------------------------------------------------------------------------------

@@ -16,13 +16,16 @@ been searched in vain:
    it with the utility of Eq. 3, ``α·N − (d(x, c) + d(c, l*))`` with grid path lengths
    (:mod:`pfctl.core.paths`); the way-point is the best cluster point. With no frontier, the
    way-point is l* itself.
+
+``choice="nearest"`` replaces step 2's utility by the nearest reachable frontier (the classic
+nearest-frontier exploration of Yamauchi, 1997): a baseline that shows what Eq. 3 and l* add.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import networkx as nx
 import numpy as np
@@ -45,7 +48,9 @@ if TYPE_CHECKING:
     from pfctl.core.grid import OccupancyGrid
 
 __all__ = [
+    "WAYPOINT_CHOICES",
     "RegionMap",
+    "WaypointChoice",
     "WaypointDecision",
     "heading_region",
     "heading_scores",
@@ -256,6 +261,11 @@ def heading_region(
     return best
 
 
+WaypointChoice = Literal["utility", "nearest"]
+"""How Algorithm 1 picks among the frontier clusters (:func:`waypoint_search`)."""
+WAYPOINT_CHOICES: tuple[WaypointChoice, ...] = ("utility", "nearest")
+
+
 @dataclass(frozen=True, eq=False)
 class WaypointDecision:
     """What Algorithm 1 decided, and why (for the behaviour tree, the log and the plots).
@@ -267,7 +277,9 @@ class WaypointDecision:
     ``"no_frontier_fallback"`` (no frontier cluster: go to l*'s point),
     ``"unreachable_frontier_fallback"`` (clusters, none reachable: go to l*'s point) or
     ``"no_target"`` (nothing at all: stay at the robot's position). ``clusters``, ``goals`` (the
-    cluster point closest to l*), ``utilities`` (Eq. 3) line up; ``best`` indexes them.
+    cluster point closest to l*), ``utilities`` (Eq. 3) line up; ``best`` indexes them. With
+    ``choice`` ``"nearest"`` the goals are the cluster points closest to the robot and the
+    utilities are −d(x, c), so the best is the nearest.
     """
 
     waypoint: XY
@@ -279,6 +291,7 @@ class WaypointDecision:
     goals: tuple[XY, ...] = field(default=(), repr=False)
     utilities: tuple[float, ...] = ()
     best: int | None = None
+    choice: WaypointChoice = "utility"
 
 
 def waypoint_search(
@@ -297,6 +310,7 @@ def waypoint_search(
     occupied_thresh: float = OCCUPIED_THRESH,
     confine_to_regions: bool = True,
     robot_region_fallback: bool = True,
+    choice: WaypointChoice = "utility",
 ) -> WaypointDecision:
     """**Algorithm 1**, way-point search, end to end (§II-B/C/D).
 
@@ -324,7 +338,17 @@ def waypoint_search(
     4. The way-point is the c of the best utility (first cluster on ties; clusters come largest
        first). Without any reachable cluster: l*'s point — moved to the nearest non-occupied
        cell of the region if the grid has it occupied — or, lacking l*, the robot's position.
+
+    ``choice="nearest"`` is the nearest-frontier baseline instead of Eq. 3 in steps 3-4: c is
+    each cluster's point closest to the robot, its score −d(x, c) (the same grid path length),
+    and the way-point the nearest reachable c; N and l* play no part in the choice (l* still
+    gives the way-point when no frontier is reachable).
     """
+    if choice not in WAYPOINT_CHOICES:
+        raise ValueError(
+            f"unknown choice {choice!r}; expected one of {', '.join(WAYPOINT_CHOICES)}"
+        )
+    nearest = choice == "nearest"
     robot = np.asarray(robot_xy, dtype=float)[:2]
     heading = heading_region(history, region_map, window_s)
     target = heading
@@ -350,17 +374,20 @@ def waypoint_search(
             downsample=downsample,
             known=states != UNKNOWN,
         )
-        anchor = robot if target_point is None else np.asarray(target_point)
-        starts = [robot] if target_point is None else [robot, anchor]
+        anchor = robot if target_point is None or nearest else np.asarray(target_point)
+        starts = [robot] if target_point is None or nearest else [robot, anchor]
         fields = distance_fields(tr, np.array(starts))
         # Eq. 3 for all clusters at once — the same numbers as utility(cluster, robot,
         # target_point, alpha, fields[0], fields[1]), one vectorised field lookup per term.
         goal_array = np.array([closest_point(c, anchor) for c in clusters])
         cost = fields[0](goal_array)
-        if target_point is not None:
+        if len(starts) == 2:
             cost = cost + fields[1](goal_array)
-        n_unknown = np.array([c.n_unknown for c in clusters], dtype=float)
-        u = alpha * n_unknown - cost
+        if nearest:
+            u = -cost
+        else:
+            n_unknown = np.array([c.n_unknown for c in clusters], dtype=float)
+            u = alpha * n_unknown - cost
         goals = [(float(g[0]), float(g[1])) for g in goal_array]
         utilities = [float(v) for v in u]
         if np.isfinite(u).any():
@@ -372,6 +399,7 @@ def waypoint_search(
         clusters=tuple(clusters),
         goals=tuple(goals),
         utilities=tuple(utilities),
+        choice=choice,
     )
     if best is not None:
         return WaypointDecision(waypoint=goals[best], reason="frontier", best=best, **common)

@@ -268,11 +268,13 @@ class WaypointSearch(Action):
         not see past an obstacle, e.g. round the end of a bookshelf — gets its nearest point
         that is not near a visited way-point (keeping its utility): the robot follows the
         frontier along instead of leaving the room. A cluster with no such point is out; with
-        no cluster left, the way-point is l*'s point (``visited_fallback``)."""
+        no cluster left, the way-point is l*'s point (``visited_fallback``). With the
+        nearest-frontier choice, "nearest" is to the robot, not to l*."""
         if decision.reason != "frontier":
             return decision  # no reachable frontier: Algorithm 1 already goes to l*
         pose = self.bb.pose
-        anchor = decision.target_point or (pose.x, pose.y)
+        here = (pose.x, pose.y)
+        anchor = here if decision.choice == "nearest" else decision.target_point or here
         goals: list[tuple[float, float]] = []
         utilities: list[float] = []
         for cluster, goal, u in zip(
@@ -332,17 +334,30 @@ def _with_waypoint(decision: WaypointDecision, goal: tuple[float, float]) -> Way
 
 
 class GoToLastSeen(Action):
-    """MOVE_BASE to where the target was last detected; SUCCESS on arrival, FAILURE if never
-    seen or unreachable."""
+    """MOVE_BASE to where the target was last detected: RUNNING while driving there, SUCCESS on
+    arrival, FAILURE if the target was never seen or the place cannot be reached. The outcome
+    holds for that sighting (as go_to_prediction's arrival does): a robot that turns or drifts
+    at the place (look_around next) does not drive back into it, and one that could not get there
+    does not try again on every tick; a new sighting starts afresh. The "go to the last seen
+    position" baseline (``missions/trees/last_seen.yaml``)."""
+
+    def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
+        super().__init__(name, namespace, params)
+        self._outcome: tuple[float, Status] | None = None
+        """(the sighting's time, SUCCESS or FAILURE) once the drive there has ended."""
 
     def act(self) -> Status:
         seen = self.last_seen
         if seen is None:
             return Status.FAILURE
+        if self._outcome is not None and self._outcome[0] == seen.t:
+            return self._outcome[1]
         outcome = self.skills.go_to(seen.xy, self.params["tolerance"])
-        if outcome == "arrived":
-            return Status.SUCCESS
-        return Status.FAILURE if outcome == "failed" else Status.RUNNING
+        if outcome == "running":
+            return Status.RUNNING
+        status = Status.SUCCESS if outcome == "arrived" else Status.FAILURE
+        self._outcome = (seen.t, status)
+        return status
 
 
 class Stop(Action):

@@ -175,7 +175,8 @@ LEAF_SPECS: dict[str, LeafSpec] = {
         LeafSpec(
             "go_to_last_seen",
             "action",
-            "Navigate to where the target was last seen; success on arrival.",
+            "Navigate to where the target was last seen; success on arrival (and from then on "
+            "for that sighting), failure when it was never seen or there is no way there.",
             (_p("tolerance", 0.5, "arrival distance, m", minimum=0.05),),
         ),
         LeafSpec("stop", "action", "Stop the base; success."),

@@ -31,7 +31,7 @@ from pfctl.core.control import (
 )
 from pfctl.core.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.planning import GridPlanner
-from pfctl.core.regions import RegionMap, WaypointDecision, waypoint_search
+from pfctl.core.regions import RegionMap, WaypointChoice, WaypointDecision, waypoint_search
 from pfctl.core.robot import STOP, HeadState, HeadTarget, NavStatus, Pose2D, Robot, Twist2D
 
 #: A new MOVE_BASE goal is sent only when it moved farther than this from the one being driven to.
@@ -51,6 +51,9 @@ class SearchParams:
     frontier_threshold: float = 0.1
     min_frontier_cells: int = 5
     heading_window_s: float = 3.0
+    waypoint_choice: WaypointChoice = "utility"
+    """``utility`` (Eq. 3, the paper) or ``nearest`` (the nearest reachable frontier, a
+    baseline; :func:`~pfctl.core.regions.waypoint_search`)."""
 
 
 class Skills:
@@ -275,7 +278,8 @@ class Skills:
     def next_waypoint(self, history: ArrayLike) -> WaypointDecision:
         """Algorithm 1 on the robot's occupancy grid for the target's ``history`` (t, x, y).
         With no history (the target was never seen) l* is None: the frontiers are scored by
-        their size and distance alone (Eq. 3 without the d(c, l*) term)."""
+        their size and distance alone (Eq. 3 without the d(c, l*) term). The frontier is chosen
+        by ``search.waypoint_choice``."""
         s = self.search
         h = since_region_entered(np.asarray(history, dtype=float).reshape(-1, 3), self.regions)
         return waypoint_search(
@@ -289,6 +293,7 @@ class Skills:
             s.min_frontier_cells,
             s.heading_window_s,
             robot_region_fallback=False,
+            choice=s.waypoint_choice,
         )
 
 
