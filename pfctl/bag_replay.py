@@ -10,7 +10,9 @@
   ``…depth…image…`` / ``…camera_info`` triple); images and depth pair up by stamp; a person-label
   image (``/pfctl/person_labels``, :mod:`pfctl.backends.hsr.person_labels`, as ``pfctl sim
   serve-hsr`` or a person detector on the robot publishes it) of the same stamp becomes the
-  frame's ``mask``.
+  frame's ``mask``; without one, person keypoints (``/pfctl/person_keypoints``,
+  ``sensor_msgs/PointCloud``, :mod:`pfctl.backends.hsr.person_keypoints`) of the same stamp
+  become the frame's ``people``.
 
 :meth:`Replay.stream` then yields :class:`~pfctl.core.robot.LaserScan` and
 :class:`~pfctl.core.robot.RgbdFrame` values in bag order, posed in the fixed frame through the
@@ -26,13 +28,15 @@ from typing import Any
 
 import numpy as np
 
+from pfctl.backends.hsr.person_keypoints import people_from_cloud
 from pfctl.bags import LASER_SCAN, Bag, BagError, laser_scan, open_bag, stamp_seconds
-from pfctl.core.robot import CameraInfo, LaserScan, Pose2D, RgbdFrame
+from pfctl.core.robot import CameraInfo, GivenPerson, LaserScan, Pose2D, RgbdFrame
 from pfctl.core.tf_buffer import TransformBuffer, TransformLookupError
 from pfctl.errors import UserError
 
 IMAGE = "sensor_msgs/msg/Image"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+POINT_CLOUD = "sensor_msgs/msg/PointCloud"
 TF = "tf2_msgs/msg/TFMessage"
 OCCUPANCY_GRID = "nav_msgs/msg/OccupancyGrid"
 #: Camera topics tried first: the HSR's (Toyota's ROS 1 stack) and the simulator's recordings.
@@ -52,6 +56,8 @@ KNOWN_CAMERAS = (
 SYNC_SLOP = 0.02
 #: Person labels (an instance/part image, :mod:`pfctl.backends.hsr.person_labels`) tried first.
 KNOWN_LABELS = ("/pfctl/person_labels",)
+#: Person keypoints (2-D keypoints/boxes, :mod:`pfctl.backends.hsr.person_keypoints`).
+KNOWN_KEYPOINTS = ("/pfctl/person_keypoints",)
 
 
 @dataclass(frozen=True)
@@ -63,12 +69,18 @@ class CameraTopics:
     info: str
     labels: str | None = None
     """A 16UC1 person-label image of the same stamps (the frames' ``mask``), if the bag has one."""
+    keypoints: str | None = None
+    """Person keypoints of the same stamps (the frames' ``people``), if the bag has them and no
+    labels."""
 
     def images(self) -> dict[str, str]:
-        """Image topic by kind: ``rgb``, ``depth`` and, when known, ``labels``."""
+        """The topics paired by stamp into one frame, by kind: ``rgb``, ``depth`` and, when
+        known, ``labels`` or ``keypoints``."""
         kinds = {"rgb": self.rgb, "depth": self.depth}
         if self.labels is not None:
             kinds["labels"] = self.labels
+        elif self.keypoints is not None:
+            kinds["keypoints"] = self.keypoints
         return kinds
 
 
@@ -133,7 +145,17 @@ class Replay:
                 self._skip("frame before any camera_info")
                 yield None
                 continue
-            yield self._frame(msgs["rgb"], msgs["depth"], msgs.get("labels"), info)
+            frame = self._frame(msgs["rgb"], msgs["depth"], msgs.get("labels"), info)
+            if frame is not None and "keypoints" in msgs:
+                frame = replace(frame, people=self._people(msgs["keypoints"], frame))
+            yield frame
+
+    def _people(self, msg: Any, frame: RgbdFrame) -> tuple[GivenPerson, ...]:
+        assert self.camera is not None and self.camera.keypoints is not None
+        try:
+            return people_from_cloud(msg, frame.depth.shape)
+        except ValueError as err:
+            raise UserError(f"{self.bag.path}: {self.camera.keypoints}: {err}") from None
 
     def _pose(self, frame_id: str, stamp: float) -> Pose2D | None:
         if frame_id.lstrip("/") == self.frame:
@@ -242,9 +264,12 @@ def _read_tf(bag: Bag) -> TransformBuffer:
 def _find_camera(bag: Bag) -> CameraTopics | None:
     have = bag.topics
     labels = next((t for t in KNOWN_LABELS if have.get(t) == IMAGE), None)
+    keypoints = None
+    if labels is None:
+        keypoints = next((t for t in KNOWN_KEYPOINTS if have.get(t) == POINT_CLOUD), None)
     for rgb, depth, info in KNOWN_CAMERAS:
         if have.get(rgb) == IMAGE and have.get(depth) == IMAGE and have.get(info) == CAMERA_INFO:
-            return CameraTopics(rgb, depth, info, labels)
+            return CameraTopics(rgb, depth, info, labels, keypoints)
     images = sorted(t for t, m in have.items() if m == IMAGE and t != labels)
     rgbs = [t for t in images if "rgb" in t or "color" in t]
     depths = [t for t in images if "depth" in t]
@@ -252,7 +277,7 @@ def _find_camera(bag: Bag) -> CameraTopics | None:
     if len(rgbs) == 1 and len(depths) == 1 and infos:
         ns = rgbs[0].rsplit("/", 1)[0]
         info = next((i for i in infos if i.startswith(ns)), infos[0])
-        return CameraTopics(rgbs[0], depths[0], info, labels)
+        return CameraTopics(rgbs[0], depths[0], info, labels, keypoints)
     return None
 
 

@@ -1081,11 +1081,23 @@ class HsrConfig(_Model):
 
     The defaults are the names of Toyota's ROS 1 stack; ``pfctl sim serve-hsr`` serves exactly
     these, so the same mission drives the robot and the simulated house. Person detections come
-    from ``person_labels`` (an instance-segmentation image published by a person detector, e.g. an
-    OpenPose node on another machine, or the simulator): ``sensor_msgs/Image``, encoding ``16UC1``
-    (``mono16``), the RGB image's size and stamp; pixel value 0 is no person, value ``v > 0`` is
-    person ``(v - 1) // 4`` (an index that only has to be stable within one image) and body part
-    ``(v - 1) % 4`` (0 unknown, 1 head, 2 torso, 3 leg).
+    from one of two sources (§II-E: the paper's OpenPose ran beside the robot):
+
+    * ``person_labels`` (the default): an instance-segmentation image published by a person
+      detector (e.g. an OpenPose node on another machine, or the simulator):
+      ``sensor_msgs/Image``, encoding ``16UC1`` (``mono16``), the RGB image's size and stamp;
+      pixel value 0 is no person, value ``v > 0`` is person ``(v - 1) // 4`` (an index that only
+      has to be stable within one image) and body part ``(v - 1) % 4`` (0 unknown, 1 head,
+      2 torso, 3 leg).
+    * ``person_keypoints`` (when set; then ``person_labels`` is not subscribed and must be left
+      out or null): 2-D keypoints and boxes as a ``sensor_msgs/PointCloud``
+      (:mod:`pfctl.backends.hsr.person_keypoints`): ``header.stamp`` = the stamp of the RGB image
+      the detector ran on (paired with RGB, depth and camera_info like the labels),
+      ``header.frame_id`` = the RGB optical frame; one point per keypoint, ``x`` = pixel column,
+      ``y`` = pixel row, ``z`` = confidence (≤ 0: not found); channels ``person`` (an index
+      stable within the message) and ``part`` (OpenPose BODY_25 index 0-24; 25 = the box's
+      top-left corner, 26 = its bottom-right corner, for detectors that give boxes), one value
+      per point. The follower places each person in 3-D from the depth around its torso.
     """
 
     laser: Topic = "/hsrb/base_scan"
@@ -1097,7 +1109,11 @@ class HsrConfig(_Model):
     camera_info: Topic = "/hsrb/head_rgbd_sensor/rgb/camera_info"
     """sensor_msgs/CameraInfo of the RGB image."""
     person_labels: Topic | None = "/pfctl/person_labels"
-    """sensor_msgs/Image 16UC1 person/part labels (see above); null: no camera detections."""
+    """sensor_msgs/Image 16UC1 person/part labels (see above); null: no camera detections
+    (unless ``person_keypoints`` is set)."""
+    person_keypoints: Topic | None = None
+    """sensor_msgs/PointCloud of 2-D keypoints/boxes (see above), e.g. ``/pfctl/person_keypoints``
+    from a relay of an OpenPose node; null: the person labels are the source."""
     joint_states: Topic = "/hsrb/joint_states"
     """sensor_msgs/JointState with head_pan_joint and head_tilt_joint."""
     odom: Topic = "/hsrb/odom"
@@ -1122,6 +1138,22 @@ class HsrConfig(_Model):
     """Zero velocity is published when the laser or the pose is older than this (wall) time, s."""
     connect_timeout: Positive = 20.0
     """How long to wait at start for the first laser scan, pose and clock, s."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _one_person_source(cls, data: Any) -> Any:
+        """With ``person_keypoints`` the keypoints are the person source: ``person_labels`` is
+        then null (not subscribed); naming a labels topic as well is an error."""
+        if not isinstance(data, Mapping) or data.get("person_keypoints") is None:
+            return data
+        labels = data.get("person_labels")
+        if labels is not None:
+            raise _fail(
+                ("person_keypoints",),
+                f"expected one person source, got person_labels ({labels}) as well: leave "
+                "person_labels out (or null) to take the people from the keypoints",
+            )
+        return {**data, "person_labels": None}
 
 
 class BackendConfig(_Model):

@@ -214,6 +214,38 @@ def test_tree_node_is_usable_alone() -> None:
         TreeNode.model_validate({"sequence": {"children": [{"action": "go"}]}})
 
 
+def test_person_keypoints_replace_the_person_labels(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """backend.hsr: the labels are the default person source; setting person_keypoints makes
+    the keypoints the source (labels null, not subscribed); naming both is an error."""
+    hsr = loads_mission(MINIMAL).backend.hsr
+    assert (hsr.person_labels, hsr.person_keypoints) == ("/pfctl/person_labels", None)
+    keypoints = "backend:\n  hsr:\n    person_keypoints: /pfctl/person_keypoints\n"
+    hsr = loads_mission(MINIMAL + keypoints).backend.hsr
+    assert (hsr.person_labels, hsr.person_keypoints) == (None, "/pfctl/person_keypoints")
+    hsr = loads_mission(MINIMAL + keypoints + "    person_labels: null\n").backend.hsr
+    assert (hsr.person_labels, hsr.person_keypoints) == (None, "/pfctl/person_keypoints")
+    both = tmp_path / "both.yaml"
+    both.write_text(
+        edit(
+            "name: small\n",
+            "name: small\n"
+            + keypoints.replace(
+                "    person_keypoints",
+                "    person_labels: /pfctl/person_labels\n    person_keypoints",
+            ),
+        )
+    )
+    code, out, err = run_cli(["mission", "validate", str(both)], capsys, monkeypatch)
+    assert code == 2 and out == ""
+    assert_one_error_line(
+        err,
+        f"pfctl: error: {both}:5: backend.hsr.person_keypoints: expected one person source, got "
+        "person_labels (/pfctl/person_labels) as well: leave person_labels out (or null)",
+    )
+
+
 # --------------------------------------------------------------------------------------------
 # broken missions through the CLI: exit 2, one line, file:line: key.path: expected
 # --------------------------------------------------------------------------------------------

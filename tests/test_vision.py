@@ -2,10 +2,12 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from pfctl.core.robot import CameraInfo, RgbdFrame
+from pfctl.core.robot import CameraInfo, GivenPerson, RgbdFrame
 from pfctl.core.vision import (
     BODY_HALF_DEPTH,
     GivenPersonDetector,
@@ -101,6 +103,44 @@ def test_given_detections_get_positions_from_the_central_depth() -> None:
     (d,) = given.detect(_frame(depth))
     assert d.position[0] == pytest.approx(2.5 + BODY_HALF_DEPTH, abs=1e-3)
     assert d.keypoints == {"neck": (80.0, 40.0)} and d.score == 0.9
+
+
+def test_given_people_on_the_frame_are_placed_by_the_depth_around_their_torso() -> None:
+    """The frame's own people (a keypoint source, e.g. OpenPose over ROS) win over set(); with
+    torso keypoints the depth is read around them, where the box's centre would miss the body
+    (here: a person at the box's left side, background in its middle)."""
+    depth = np.full((H, W), 9.0)
+    depth[30:90, 40:56] = 2.5  # the body
+    box = (30, 20, 110, 100)  # a loose box: its centre is background
+    torso = {
+        "neck": (47.0, 36.0),
+        "right_shoulder": (42.0, 38.0),
+        "left_shoulder": (53.0, 38.0),
+        "mid_hip": (47.0, 70.0),
+        "head": (47.0, 25.0),
+    }
+    person = GivenPerson(box, torso, 0.8, head_box=(42, 20, 53, 31))
+    given = GivenPersonDetector()
+    given.set([((0, 0, 10, 10), None, 1.0)])  # not used: the frame has its own people
+    frame = replace(_frame(depth), people=(person, GivenPerson(box, None, 0.5)))
+    placed, by_box = given.detect(frame)
+    assert placed.position[0] == pytest.approx(2.5 + BODY_HALF_DEPTH, abs=0.01)  # the body
+    assert (placed.box, placed.head_box, placed.score) == (box, (42, 20, 53, 31), 0.8)
+    assert placed.keypoints == torso
+    assert by_box.position[0] == pytest.approx(9.0 + BODY_HALF_DEPTH, abs=0.01)  # no keypoints
+    assert given.detect(replace(frame, people=())) == []  # the source found nobody
+    # torso keypoints without depth (or outside the image): the box's central depth
+    hole = depth.copy()
+    hole[30:90, 40:56] = np.inf
+    (fallback,) = given.detect(replace(_frame(hole), people=(person,)))
+    assert fallback.position[0] == pytest.approx(9.0 + BODY_HALF_DEPTH, abs=0.01)
+    outside = GivenPerson(box, {"neck": (-5.0, 40.0), "mid_hip": (200.0, 70.0)})
+    (far,) = given.detect(replace(frame, people=(outside,)))
+    assert far.position[0] == pytest.approx(9.0 + BODY_HALF_DEPTH, abs=0.01)
+    # without people on the frame, set() gives them (also as GivenPerson values)
+    given.set([person])
+    (again,) = given.detect(_frame(depth))
+    assert again.position == placed.position
 
 
 def test_non_max_suppression_keeps_the_best_of_overlapping_boxes() -> None:

@@ -13,7 +13,8 @@ and the 128-D embeddings of their face. Two sources:
 - ``--backend hsr``: the same on a Toyota HSR over ROS 1 (or the simulated house served by
   ``pfctl sim serve-hsr --pose-target``): the person stands :data:`STAND_DISTANCE` m straight in
   front of the robot, which stands still and nods its head between a face and a body height for
-  ``--seconds`` of ROS time; detections come from the mission's ``backend.hsr.person_labels``.
+  ``--seconds`` of ROS time; detections come from the mission's ``backend.hsr.person_labels``
+  (or ``person_keypoints``).
 - ``--from PATH``: a folder of images (``.png``, ``.jpg``, ...), one image, or a video file (at
   most :data:`MAX_VIDEO_FRAMES` frames, evenly spaced) of the person, read with OpenCV. Each
   image is searched with OpenCV's HOG people detector. When it finds nobody and the image is
@@ -221,7 +222,8 @@ def _learn_on_hsr(
         detector = robot.person_detector()
         if detector is None:
             raise UserError(
-                "backend.hsr.person_labels: is null, so the robot detects no one to learn"
+                "backend.hsr.person_labels: is null (and person_keypoints too), so the robot "
+                "detects no one to learn"
             )
         try:
             return learn_on_robot(

@@ -2,7 +2,8 @@
 
 Leg detection and tracking run on every scan of the bag (and, when the bag has RGB-D topics,
 person detection — from the bag's person-label image when it has one (``/pfctl/person_labels``),
-else OpenCV's HOG — fuses into the same tracks; with ``--target`` Algorithm 2 names the target),
+else from its person keypoints (``/pfctl/person_keypoints``, placed in 3-D by the depth), else
+OpenCV's HOG — fuses into the same tracks; with ``--target`` Algorithm 2 names the target),
 posed in a fixed frame through the bag's ``/tf``. After each scan, every confirmed track that is
 currently seen (coasting tracks are left out: they are extrapolations) is one row of
 ``tracks.csv``: ``t,track_id,x,y,vx,vy,confidence,is_target``. ``tracks.png`` draws the tracks
@@ -30,7 +31,12 @@ from pfctl.core.episode import TrackRow
 from pfctl.core.identity import TargetProfile
 from pfctl.core.perception import Perception
 from pfctl.core.robot import LaserScan, RgbdFrame
-from pfctl.core.vision import HogPersonDetector, PersonDetector, hog_available
+from pfctl.core.vision import (
+    GivenPersonDetector,
+    HogPersonDetector,
+    PersonDetector,
+    hog_available,
+)
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
 from pfctl.perception_setup import build_perception
@@ -96,6 +102,8 @@ def replay(
         detector: PersonDetector | None = None
         if source.camera is not None and source.camera.labels is not None:
             detector = label_detector(mission.perception.vision.min_pixels)
+        elif source.camera is not None and source.camera.keypoints is not None:
+            detector = GivenPersonDetector()
         elif source.camera is not None:
             if not hog_available():
                 raise UserError("the camera needs OpenCV's HOG people detector (OpenCV < 5)")

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
@@ -154,10 +155,27 @@ class CameraInfo:
 
 
 @dataclass(frozen=True)
+class GivenPerson:
+    """A person an external detector found in a frame's colour image, in 2-D only (§II-E: the
+    paper's OpenPose ran beside the robot; the follower places its people in 3-D with the
+    depth, :class:`pfctl.core.vision.GivenPersonDetector`)."""
+
+    box: tuple[int, int, int, int]
+    """Image box ``(x0, y0, x1, y1)`` of the whole body, pixels (``x1``, ``y1`` exclusive)."""
+    keypoints: Mapping[str, tuple[float, float]] | None = None
+    """2-D keypoints ``name -> (u, v)`` (:data:`pfctl.core.vision.Keypoints`), when known."""
+    score: float = 1.0
+    """The detector's confidence (OpenPose: the mean confidence of the keypoints)."""
+    head_box: tuple[int, int, int, int] | None = None
+    """Where the head is, when the detector knows (Algorithm 2 searches faces there)."""
+
+
+@dataclass(frozen=True)
 class RgbdFrame:
     """One RGB-D image: colour ``(h, w, 3) uint8``, metric depth ``(h, w) float32`` (m, ``inf``
     where nothing is seen), an optional segmentation mask ``(h, w) int32`` (backend body ids; the
-    simulator's only, for tests and labels), the intrinsics, and the camera's pose.
+    simulator's only, for tests and labels), the people an external detector found in it
+    (``people``, when the backend has such a source), the intrinsics, and the camera's pose.
 
     ``camera_position`` / ``camera_rotation`` give the optical frame in the map frame: the
     rotation's columns are the camera's x (right), y (down), z (forward) axes in map coordinates.
@@ -170,6 +188,10 @@ class RgbdFrame:
     camera_position: tuple[float, float, float]
     camera_rotation: np.ndarray
     mask: np.ndarray | None = None
+    people: tuple[GivenPerson, ...] | None = None
+    """The people an external 2-D detector found in this image (e.g. OpenPose keypoints over
+    ROS, stamped like the image); None: the frame comes with no such detections (an empty tuple
+    means the detector ran and found no one)."""
 
 
 @dataclass(frozen=True)

@@ -11,7 +11,8 @@ body. Here a detector is anything with ``detect(frame) -> list[PersonDetection]`
   2005, ``cv2.HOGDescriptor_getDefaultPeopleDetector``, nothing to download) for real cameras,
   with non-maximum suppression.
 - :class:`GivenPersonDetector`: wraps boxes / keypoints from an external pose source (e.g.
-  OpenPose over ROS on the real robot) and adds the 3-D positions.
+  OpenPose over ROS on the real robot, carried on the frame as ``RgbdFrame.people``) and adds
+  the 3-D positions (from the depth around the torso keypoints when there are some).
 
 The 3-D position (:func:`body_position`) is robust: the median of the map-frame 3-D points of
 the body pixels with a valid depth (back-projected with the intrinsics, through the frame's
@@ -29,7 +30,7 @@ from typing import Literal, Protocol, runtime_checkable
 import numpy as np
 
 from pfctl.core.faces import Box
-from pfctl.core.robot import RgbdFrame
+from pfctl.core.robot import GivenPerson, RgbdFrame
 
 #: Half the front-to-back depth of a person's body, metres: a surface point's offset from the
 #: body's centre along the line of sight.
@@ -40,7 +41,12 @@ _PARTS = {"head": 1, "torso": 2, "leg": 3}
 
 Keypoints = Mapping[str, tuple[float, float]]
 """2-D keypoints ``name -> (u, v)`` in pixels. Names used here (OpenPose BODY_25 spirit):
-``head`` (centre of the head), ``neck``, ``mid_hip``, ``ankles`` (mid-point of the feet)."""
+``head`` (centre of the head), ``neck``, ``mid_hip``, ``ankles`` (mid-point of the feet); a
+pose estimator may add ``right_shoulder``, ``left_shoulder``, ``right_hip`` and ``left_hip``
+(BODY_25 2, 5, 9, 12), which :class:`GivenPersonDetector` measures the depth around."""
+
+TORSO_KEYPOINTS = ("neck", "right_shoulder", "left_shoulder", "mid_hip", "right_hip", "left_hip")
+"""The keypoints on the torso: a given person's depth is read around them (and their centre)."""
 
 
 @dataclass(frozen=True)
@@ -269,26 +275,83 @@ def central_pixels(box: Box, shape: tuple[int, int], fraction: float) -> tuple[n
     return us.ravel(), vs.ravel()
 
 
+def torso_pixels(
+    keypoints: Keypoints, box: Box, shape: tuple[int, int], window: float = 0.03
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """Pixel coordinates ``(us, vs)`` around a person's :data:`TORSO_KEYPOINTS` and their
+    centre: a square of half-size ``window`` × the box's height (at least 2 px) around each,
+    clipped to the image ``shape``; None when no torso keypoint is inside the image."""
+    h, w = shape
+    points = [keypoints[k] for k in TORSO_KEYPOINTS if k in keypoints]
+    points = [(u, v) for u, v in points if 0 <= u < w and 0 <= v < h]
+    if not points:
+        return None
+    if len(points) > 1:
+        points.append(
+            (sum(u for u, _ in points) / len(points), sum(v for _, v in points) / len(points))
+        )
+    r = max(2, round(window * (box[3] - box[1])))
+    us, vs = [], []
+    for u, v in points:
+        cu, cv = int(u), int(v)
+        u0, u1 = max(0, cu - r), min(w, cu + r + 1)
+        v0, v1 = max(0, cv - r), min(h, cv + r + 1)
+        grid_v, grid_u = np.mgrid[v0:v1, u0:u1]
+        us.append(grid_u.ravel())
+        vs.append(grid_v.ravel())
+    return np.concatenate(us), np.concatenate(vs)
+
+
 class GivenPersonDetector:
-    """People from an external source (e.g. OpenPose keypoints over ROS): boxes and optional
-    keypoints are given per frame with :meth:`set`; :meth:`detect` adds the 3-D positions from
-    the median depth of the box's central part."""
+    """People from an external 2-D source (§II-E: OpenPose, whose detections the paper placed
+    in 3-D with the depth image): the frame's own ``RgbdFrame.people`` when it has them (the HSR
+    backend's ``person_keypoints`` topic, a replayed bag's), else the boxes and optional
+    keypoints given for the next frame with :meth:`set`. :meth:`detect` adds the 3-D positions
+    (:func:`body_position`'s conventions): from the depth around the torso keypoints
+    (:func:`torso_pixels`: neck, shoulders, hips and their centre) when the person has some,
+    else — or when none of those pixels has a depth — from the box's central part
+    (``central_fraction`` of its width and height)."""
 
-    def __init__(self, central_fraction: float = 0.4) -> None:
+    def __init__(self, central_fraction: float = 0.4, torso_window: float = 0.03) -> None:
         self.central_fraction = central_fraction
-        self._given: list[tuple[Box, Keypoints | None, float]] = []
+        self.torso_window = torso_window
+        self._given: list[GivenPerson] = []
 
-    def set(self, people: Sequence[tuple[Box, Keypoints | None, float]]) -> None:
-        """The people of the next frame: ``(box, keypoints or None, score)`` each."""
-        self._given = list(people)
+    def set(self, people: Sequence[tuple[Box, Keypoints | None, float] | GivenPerson]) -> None:
+        """The people of the next frame (used when the frame carries none of its own):
+        :class:`~pfctl.core.robot.GivenPerson` or ``(box, keypoints or None, score)`` each."""
+        self._given = [
+            p if isinstance(p, GivenPerson) else GivenPerson(p[0], p[1], float(p[2]))
+            for p in people
+        ]
+
+    def position(self, frame: RgbdFrame, person: GivenPerson) -> tuple[float, float, float] | None:
+        """The person's body centre in the map frame (class docstring), or None without depth."""
+        shape = frame.depth.shape
+        if person.keypoints:
+            torso = torso_pixels(person.keypoints, person.box, shape, self.torso_window)
+            if torso is not None:
+                position = body_position(frame, *torso)
+                if position is not None:
+                    return position
+        us, vs = central_pixels(person.box, shape, self.central_fraction)
+        return body_position(frame, us, vs)
 
     def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        people = frame.people if frame.people is not None else self._given
         out = []
-        for box, keypoints, score in self._given:
-            us, vs = central_pixels(box, frame.depth.shape, self.central_fraction)
-            position = body_position(frame, us, vs)
+        for person in people:
+            position = self.position(frame, person)
             if position is not None:
-                out.append(PersonDetection(box, position, float(score), keypoints=keypoints))
+                out.append(
+                    PersonDetection(
+                        person.box,
+                        position,
+                        float(person.score),
+                        keypoints=person.keypoints,
+                        head_box=person.head_box,
+                    )
+                )
         return out
 
 
@@ -395,6 +458,7 @@ def make_detector(
 
 __all__ = [
     "BODY_HALF_DEPTH",
+    "TORSO_KEYPOINTS",
     "DetectorUnavailableError",
     "GivenPersonDetector",
     "HogPersonDetector",
@@ -409,4 +473,5 @@ __all__ = [
     "make_detector",
     "non_max_suppression",
     "pixels_to_map",
+    "torso_pixels",
 ]

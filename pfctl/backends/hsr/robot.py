@@ -6,13 +6,15 @@ head commands, and drives ``move_base`` through actionlib:
 
 * **observe** — the newest laser scan since the previous observation, posed by tf
   ``map → <scan frame>`` at the scan's stamp; the newest complete RGB-D frame (RGB, depth,
-  camera info and, when configured, the person labels of one stamp, paired within
-  :data:`CAMERA_SLOP`), the camera's optical frame from tf ``map → <image frame>`` at the image's
-  stamp; the base pose (tf ``map → base`` or the ``pose`` topic); the head from the joint states;
-  the odometry; the collision count from the simulator's truth (0 without it). When tf has no
-  ``map → odom`` at a stamp yet, the odom frame is held fixed (``map → odom`` latest,
-  ``odom → frame`` at the stamp), so a slowly published localisation does not hold data back;
-  after :data:`TF_WAIT` without a transform at the stamp the latest one is used.
+  camera info and, when configured, the person labels or the person keypoints of one stamp,
+  paired within :data:`CAMERA_SLOP`; the keypoints become the frame's ``people``,
+  :mod:`pfctl.backends.hsr.person_keypoints`), the camera's optical frame from tf
+  ``map → <image frame>`` at the image's stamp; the base pose (tf ``map → base`` or the
+  ``pose`` topic); the head from the joint states; the odometry; the collision count from the
+  simulator's truth (0 without it). When tf has no ``map → odom`` at a stamp yet, the odom
+  frame is held fixed (``map → odom`` latest, ``odom → frame`` at the stamp), so a slowly
+  published localisation does not hold data back; after :data:`TF_WAIT` without a transform at
+  the stamp the latest one is used.
 * **time** — every stamp the follower sees is seconds of ROS time since the robot was opened (the
   episode clock): sim seconds when the master's ``/use_sim_time`` is true and ``/clock`` runs
   (``pfctl sim serve-hsr``), wall seconds on a real robot.
@@ -50,11 +52,13 @@ from typing import Any
 
 from pfctl.backends.hsr import convert
 from pfctl.backends.hsr.master import MASTER_ERRORS, master_proxy
+from pfctl.backends.hsr.person_keypoints import people_from_cloud
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
 from pfctl.bag_replay import image_labels
 from pfctl.core.robot import (
     STOP,
+    GivenPerson,
     GroundTruth,
     HeadState,
     HeadTarget,
@@ -68,7 +72,7 @@ from pfctl.core.robot import (
     Twist2D,
 )
 from pfctl.core.tf_buffer import quaternion_matrix
-from pfctl.core.vision import MaskPersonDetector
+from pfctl.core.vision import GivenPersonDetector, MaskPersonDetector
 from pfctl.errors import UserError
 from pfctl.mission import HsrConfig, Mission
 
@@ -128,6 +132,16 @@ def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
         for m in msg.markers
         if int(m.action) == 0
     )
+
+
+def frame_people(msg: Any, topic: str, shape: tuple[int, int]) -> tuple[GivenPerson, ...]:
+    """The people of a person-keypoints message (``sensor_msgs/PointCloud``,
+    :mod:`pfctl.backends.hsr.person_keypoints`) for an image of ``shape``;
+    :class:`RobotDataError` naming ``topic`` and what was expected when it is malformed."""
+    try:
+        return people_from_cloud(msg, shape)
+    except ValueError as err:
+        raise RobotDataError(f"{topic}: {err}") from None
 
 
 def _ns(stamp: Any) -> int:
@@ -277,8 +291,11 @@ class HsrRobot:
         camera = {"rgb": cfg.rgb, "depth": cfg.depth, "info": cfg.camera_info}
         if cfg.person_labels is not None:
             camera["labels"] = cfg.person_labels
+        if cfg.person_keypoints is not None:
+            camera["keypoints"] = cfg.person_keypoints
+        classes = {"info": sensor.CameraInfo, "keypoints": sensor.PointCloud}
         for key, topic in camera.items():
-            cls = sensor.CameraInfo if key == "info" else sensor.Image
+            cls = classes.get(key, sensor.Image)
             self._camera[key] = {}
             self._sub(
                 topic,
@@ -401,7 +418,13 @@ class HsrRobot:
                     del pending[old]
             self._frames.append(
                 (
-                    (msgs["rgb"], msgs["depth"], msgs["info"], msgs.get("labels")),
+                    (
+                        msgs["rgb"],
+                        msgs["depth"],
+                        msgs["info"],
+                        msgs.get("labels"),
+                        msgs.get("keypoints"),
+                    ),
                     time.monotonic(),
                 )
             )
@@ -947,7 +970,7 @@ class HsrRobot:
         return replace(scan, stamp=self._episode(msg.header.stamp))
 
     def _decode_frame(self, msgs: tuple[Any, ...], tf: Any) -> RgbdFrame:
-        rgb_msg, depth_msg, info_msg, labels_msg = msgs
+        rgb_msg, depth_msg, info_msg, labels_msg, keypoints_msg = msgs
         cfg = self.config
         topic = cfg.rgb
         try:
@@ -968,6 +991,9 @@ class HsrRobot:
         if len(set(shapes.values())) > 1:
             sizes = ", ".join(f"{t} {w}x{h}" for t, (h, w) in shapes.items())
             raise RobotDataError(f"camera images of different sizes: {sizes}")
+        people = None
+        if keypoints_msg is not None:
+            people = frame_people(keypoints_msg, str(cfg.person_keypoints), depth.shape)
         t, q = tf.transform.translation, tf.transform.rotation
         return RgbdFrame(
             stamp=self._episode(rgb_msg.header.stamp),
@@ -977,6 +1003,7 @@ class HsrRobot:
             camera_position=(float(t.x), float(t.y), float(t.z)),
             camera_rotation=quaternion_matrix(q.x, q.y, q.z, q.w),
             mask=mask,
+            people=people,
         )
 
     # -- beside the port ------------------------------------------------------------------------
@@ -998,8 +1025,12 @@ class HsrRobot:
             collisions=self._truth_collisions or 0,
         )
 
-    def person_detector(self) -> MaskPersonDetector | None:
-        """The detector of the person-label images (None when ``person_labels`` is null)."""
+    def person_detector(self) -> MaskPersonDetector | GivenPersonDetector | None:
+        """The camera's person detector: of the frames' people when ``person_keypoints`` is set
+        (:class:`GivenPersonDetector`), else of the person-label images; None when neither
+        topic is set."""
+        if self.config.person_keypoints is not None:
+            return GivenPersonDetector()
         if self.config.person_labels is None:
             return None
         return label_detector(self.mission.perception.vision.min_pixels)
@@ -1044,5 +1075,6 @@ __all__ = [
     "RobotConnectionError",
     "RobotDataError",
     "check_master",
+    "frame_people",
     "people_from_markers",
 ]

@@ -31,8 +31,11 @@ What is published when
        that is what the robot does, and the leg detector and MOVE_BASE's blockers see each one;
     5. at the camera's rate (10 Hz): ``rgb`` (rgb8), ``depth`` (16UC1 mm like the Xtion's
        ``image_rect_raw``, or 32FC1 m), ``camera_info`` and ``person_labels`` (16UC1, see
-       :mod:`pfctl.backends.hsr.person_labels`: the simulator's stand-in for OpenPose), all four
-       with the same stamp and frame ``head_rgbd_sensor_rgb_frame``;
+       :mod:`pfctl.backends.hsr.person_labels`: the simulator's stand-in for OpenPose) or, when
+       the mission sets it, ``person_keypoints`` (``sensor_msgs/PointCloud``, see
+       :mod:`pfctl.backends.hsr.person_keypoints`: the mask detector's people — box, head,
+       neck, mid-hip, ankles — as BODY_25 keypoints and box corners, standing in for OpenPose
+       too), all with the same stamp and frame ``head_rgbd_sensor_rgb_frame``;
     6. once per control period (and at ``t`` = 0): the truth for metrics, never for the follower:
        ``<ground_truth>/robot`` (``geometry_msgs/PoseStamped``, the true pose),
        ``<ground_truth>/people`` (``visualization_msgs/MarkerArray``, one CYLINDER per person as
@@ -87,6 +90,7 @@ import numpy as np
 
 from pfctl.backends.hsr import convert
 from pfctl.backends.hsr.master import master_proxy
+from pfctl.backends.hsr.person_keypoints import cloud_message, detection_parts
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
@@ -105,6 +109,7 @@ from pfctl.core.robot import (
     RgbdFrame,
     Twist2D,
 )
+from pfctl.core.vision import MaskPersonDetector, PersonDetection
 from pfctl.errors import UserError
 from pfctl.mission import Mission
 
@@ -327,6 +332,17 @@ class HsrMessages:
                 msg.header.stamp = stamp
         return rgb, depth, info, label_msg
 
+    def person_keypoints(self, frame: RgbdFrame, people: list[PersonDetection]) -> Any:
+        """``sensor_msgs/PointCloud`` of the mask detector's ``people`` in ``frame``
+        (:func:`~pfctl.backends.hsr.person_keypoints.detection_parts`, person = the simulator's
+        instance index), with the frame's stamp and the camera's optical frame."""
+        parts = {
+            int(d.instance if d.instance is not None else i): detection_parts(d)
+            for i, d in enumerate(people)
+        }
+        header = self.header(frame.stamp, CAMERA_FRAME)
+        return cloud_message(self.sensor, self.geometry, header, parts)
+
     def truth(self, truth: GroundTruth) -> tuple[Any, Any, Any]:
         """``(robot PoseStamped, people MarkerArray, collisions UInt32)`` (module docstring)."""
         g, t, frame = self.geometry, truth.stamp, self.cfg.map_frame
@@ -451,6 +467,9 @@ class SimHsrBridge:
         self._last_odometry: Pose2D | None = None
         self._instances = robot.person_instances()
         self._parts = robot.people_bodies.parts()
+        self._keypoint_detector = MaskPersonDetector(
+            self._instances, self._parts, min_pixels=robot.mission.perception.vision.min_pixels
+        )
 
     # -- start and stop ------------------------------------------------------------------------
 
@@ -481,6 +500,8 @@ class SimHsrBridge:
             self._pubs["pose"] = pub(cfg.pose, geometry.PoseStamped, queue_size=10)
         if cfg.person_labels is not None:
             self._pubs["labels"] = pub(cfg.person_labels, sensor.Image, queue_size=2)
+        if cfg.person_keypoints is not None:
+            self._pubs["keypoints"] = pub(cfg.person_keypoints, sensor.PointCloud, queue_size=2)
         if cfg.ground_truth is not None:
             ns = cfg.ground_truth.rstrip("/")
             self._pubs["truth_robot"] = pub(f"{ns}/robot", geometry.PoseStamped, queue_size=10)
@@ -677,6 +698,9 @@ class SimHsrBridge:
             pubs["info"].publish(info)
             if label_msg is not None:
                 pubs["labels"].publish(label_msg)
+            if "keypoints" in pubs and frame.mask is not None:
+                people = self._keypoint_detector.detect(frame)
+                pubs["keypoints"].publish(msgs.person_keypoints(frame, people))
             self.stats.frames += 1
         if period_end:
             if "truth_robot" in pubs:

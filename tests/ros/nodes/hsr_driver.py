@@ -12,6 +12,9 @@ Scenarios:
 * ``navigate``: a goal to move_base, preempted by a direct command; a second one to the end;
   then a second ``HsrRobot`` in the same process.
 * ``connect``: only connect (``--timeout``), report the error if there is one.
+* ``people`` (with ``--keypoints TOPIC``: ``backend.hsr.person_keypoints``): command zero once
+  (a bridge holding its episode starts it), then observe ``--frames`` RGB-D frames; report each
+  frame's given people, the person detector's positions and the truth of the frame's stamp.
 """
 
 from __future__ import annotations
@@ -28,7 +31,7 @@ import numpy as np
 import pfctl
 from pfctl.backends.hsr.robot import HsrRobot
 from pfctl.core.legs import LegDetector, load_leg_model
-from pfctl.core.robot import HeadTarget, Pose2D, RobotLostError, Twist2D
+from pfctl.core.robot import STOP, HeadTarget, Pose2D, RobotLostError, Twist2D
 from pfctl.core.tracking import FieldOfView
 from pfctl.errors import UserError
 from pfctl.mission import BackendConfig, HsrConfig, load_mission
@@ -158,14 +161,55 @@ def navigate(robot: HsrRobot) -> None:
         say("second", node=second.node, same=second.node == robot.node, beams=len(scan.ranges))
 
 
+def people(robot: HsrRobot, frames: int) -> None:
+    detector = robot.person_detector()
+    robot.command(STOP)  # the first command ends the bridge's hold: the episode starts
+    truths, seen = {}, []
+    for _ in range(30 * frames):
+        robot.step()
+        obs = robot.observe()
+        truth = robot.ground_truth()
+        if truth is not None:
+            truths[round(truth.stamp, 6)] = truth
+        if obs.rgbd is not None:
+            seen.append(obs.rgbd)
+        if len(seen) >= frames and round(seen[-1].stamp, 6) in truths:
+            break
+    out = []
+    for frame in seen:
+        truth = truths.get(round(frame.stamp, 6))
+        out.append(
+            {
+                "stamp": frame.stamp,
+                "mask": frame.mask is not None,
+                "given": [
+                    {
+                        "box": list(p.box),
+                        "head_box": list(p.head_box) if p.head_box else None,
+                        "keypoints": sorted(p.keypoints or {}),
+                        "score": p.score,
+                    }
+                    for p in frame.people or ()
+                ]
+                if frame.people is not None
+                else None,
+                "detected": [list(d.position) for d in detector.detect(frame)],
+                "truth": None if truth is None else [[p.name, p.x, p.y] for p in truth.people],
+            }
+        )
+    say("people", detector=type(detector).__name__, frames=out)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
-    parser.add_argument("scenario", choices=("observe", "drive", "navigate", "connect"))
+    parser.add_argument("scenario", choices=("observe", "drive", "navigate", "connect", "people"))
     parser.add_argument("--timeout", type=float, default=15.0)
     parser.add_argument("--pose", default=None, help="backend.hsr.pose")
+    parser.add_argument("--keypoints", default=None, help="backend.hsr.person_keypoints")
+    parser.add_argument("--frames", type=int, default=10, help="frames to observe (people)")
     args = parser.parse_args(sys.argv[1:])
     mission = load_mission(HOUSE)
-    hsr = HsrConfig(pose=args.pose)
+    hsr = HsrConfig(pose=args.pose, person_keypoints=args.keypoints)
     mission = mission.model_copy(update={"backend": BackendConfig(hsr=hsr)})
     started = time.monotonic()
     try:
@@ -181,9 +225,13 @@ def main() -> None:
         return
     say("connected", seconds=time.monotonic() - started, node=robot.node)
     with robot:
-        {"observe": observe, "drive": drive, "navigate": navigate, "connect": lambda r: None}[
-            args.scenario
-        ](robot)
+        {
+            "observe": observe,
+            "drive": drive,
+            "navigate": navigate,
+            "connect": lambda r: None,
+            "people": lambda r: people(r, args.frames),
+        }[args.scenario](robot)
 
 
 if __name__ == "__main__":
