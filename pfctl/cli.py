@@ -7,6 +7,7 @@ import sys
 import typer
 
 from pfctl import __version__
+from pfctl.commands import bench as bench_command
 from pfctl.commands import bt as bt_commands
 from pfctl.commands import follow as follow_commands
 from pfctl.commands import learn_target as learn_target_command
@@ -37,6 +38,7 @@ app.command("learn-target")(learn_target_command.learn_target)
 app.command("follow")(follow_commands.follow)
 app.command("search")(follow_commands.search)
 app.command("replay")(replay_command.replay)
+app.command("bench")(bench_command.bench)
 
 
 def _version(value: bool) -> None:

@@ -1,0 +1,251 @@
+"""`pfctl bench`: a campaign of seeded episodes, missions and variants side by side.
+
+``pfctl bench MISSION... [--task follow|search] [--episodes N] [--seed S] [--duration D]
+[--vary KEY=V1,V2,...]... [--workers K | --ray ADDRESS] [--out DIR] [--resume]`` runs episode
+``i`` (seed ``S + i``) of every mission under every variant (the cross product of the
+``--vary``s, :mod:`pfctl.bench.variants`) headless in the simulated house — learn the target,
+then follow them (``pfctl follow``) or find them hidden somewhere (``pfctl search``) — in
+``--workers`` spawned processes, or as Ray tasks on a cluster (``--ray``). Each finished episode
+is appended to ``OUT/results.jsonl`` at once; ``--resume`` continues a campaign from it and skips
+the episodes already done (:mod:`pfctl.bench.results`). At the end (also after Ctrl-C, with what
+finished) it prints per mission and variant the mean and 95 % bootstrap interval of each metric
+(:mod:`pfctl.bench.aggregate`) and writes ``summary.csv``, ``summary.md``, ``boxplots.png`` and
+``episodes.csv`` into ``--out``.
+
+Bad options, missions or ``--vary`` values end in one line and exit status 2 before anything is
+written. Ctrl-C stops the workers, keeps the results file, writes the summary of what finished
+and exits 130; a worker process that dies ends the campaign with exit status 1 (``--resume`` runs
+what is missing).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+
+from pfctl.bench.aggregate import metrics_for, summarize
+from pfctl.bench.episode import BLAS_THREAD_VARIABLES
+from pfctl.bench.plan import TASKS, Campaign, MissionVariant, load_variant, mission_digest
+from pfctl.bench.plan import mission_labels as _labels
+from pfctl.bench.results import RESULTS_FILE, episode_key, latest, open_results
+from pfctl.bench.runner import (
+    RAY_INSTALL,
+    WorkerDiedError,
+    ray_available,
+    run_in_processes,
+    run_on_ray,
+)
+from pfctl.bench.variants import parse_vary, variants
+from pfctl.errors import UserError
+from pfctl.files import write_output
+from pfctl.progress import progress_bar
+
+#: Default simulated seconds of an episode per task.
+DEFAULT_DURATION = {"follow": 120.0, "search": 180.0}
+
+
+def _check_options(
+    task: str, episodes: int, workers: int, duration: float, timeout: float | None
+) -> None:
+    if task not in TASKS:
+        raise UserError(f"--task {task}: expected one of {', '.join(TASKS)}")
+    if episodes < 1:
+        raise UserError(f"--episodes: expected at least 1, got {episodes}")
+    if workers < 1:
+        raise UserError(f"--workers: expected at least 1, got {workers}")
+    if not (math.isfinite(duration) and duration > 0):
+        raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
+    if timeout is not None and not (math.isfinite(timeout) and timeout >= 0):
+        raise UserError(f"--timeout: expected seconds >= 0 (0: none), got {timeout:g}")
+
+
+def build_campaign(
+    missions: list[Path],
+    task: str,
+    episodes: int,
+    seed: int,
+    duration: float,
+    vary: list[str],
+    timeout: float,
+) -> Campaign:
+    """The campaign of the command's arguments: every mission under every variant, loaded and
+    validated (one-line :class:`UserError` for the first bad one)."""
+    combos = variants([parse_vary(v) for v in vary])
+    paths = [os.path.normpath(p) for p in missions]
+    if len(set(paths)) != len(paths):
+        raise UserError("MISSION: the same mission file is given twice")
+    groups = []
+    for label, path in zip(_labels(paths), paths, strict=True):
+        for variant in combos:
+            mission = load_variant(path, variant)
+            if task == "search" and mission.scenario.target is None:
+                raise UserError(f"{path}: scenario.target: --task search needs a target to find")
+            groups.append(MissionVariant(label, path, variant, mission, mission_digest(mission)))
+    return Campaign(task, tuple(groups), episodes, seed, duration, timeout)  # type: ignore[arg-type]
+
+
+def _episode_line(record: dict[str, Any], done: int, total: int) -> str:
+    head = f"[{done}/{total}] {record['mission']} · {record['variant']} · seed {record['seed']}: "
+    if record["status"] == "error":
+        return head + f"[red]error[/red] {record['error']}"
+    m, timing = record["metrics"], record["timing"] or {}
+    wall = f", {timing['wall_s']:.0f} s wall" if timing.get("wall_s") is not None else ""
+    late = " [yellow](timed out)[/yellow]" if record["status"] == "timeout" else ""
+    if record["task"] == "search":
+        found = f"found in {m['time_to_find_s']:.1f} s" if m["found"] else "not found"
+        return head + f"{found} ({m['region']}), {m['distance_m']:.1f} m{wall}{late}"
+    return head + (
+        f"following {100 * m['following_rate']:.1f}%, losses {m['losses']} "
+        f"(re-found {m['reacquired']}), switches {m['identity_switches']}, "
+        f"collisions {m['collisions']}, {m['distance_m']:.1f} m{wall}{late}"
+    )
+
+
+def _write_summary(
+    campaign: Campaign, records: list[dict[str, Any]], out: Path, console: Console
+) -> list[Path]:
+    """Print the per-variant table and write the summary files; the files written."""
+    from pfctl.bench.plots import boxplots_png
+    from pfctl.bench.report import episodes_csv, summary_csv, summary_markdown, summary_table
+
+    planned = {s.key for s in campaign.specs()}
+    kept = [r for r in latest(records).values() if episode_key(r) in planned]
+    order = {s.key: i for i, s in enumerate(campaign.specs())}
+    kept.sort(key=lambda r: order[episode_key(r)])
+    metrics = metrics_for(campaign.task)
+    groups = list(dict.fromkeys((g.label, g.variant.name) for g in campaign.groups))
+    summaries = summarize(kept, groups, metrics)
+    last = campaign.seed + campaign.episodes - 1
+    title = (
+        f"pfctl bench: {campaign.task}, {len(kept)}/{len(planned)} episodes, "
+        f"{campaign.duration:g} s simulated, seeds {campaign.seed}..{last}"
+    )
+    Console(width=max(100, 40 + 24 * len(metrics))).print(summary_table(summaries, metrics, title))
+    files = [
+        (out / "summary.csv", summary_csv(summaries, metrics)),
+        (out / "summary.md", summary_markdown(summaries, metrics, title)),
+        (out / "episodes.csv", episodes_csv(kept)),
+        (out / "boxplots.png", boxplots_png(summaries, metrics, title)),
+    ]
+    return [write_output(path, data) for path, data in files]
+
+
+def bench(
+    missions: Annotated[
+        list[Path], typer.Argument(help="Mission YAMLs to run.", show_default=False)
+    ],
+    task: Annotated[
+        str, typer.Option("--task", help="follow (pfctl follow) or search (pfctl search).")
+    ] = "follow",
+    episodes: Annotated[
+        int, typer.Option("--episodes", help="Episodes per mission and variant.")
+    ] = 10,
+    seed: Annotated[
+        int, typer.Option("--seed", help="Seed of episode 0; episode i: seed + i.")
+    ] = 1,
+    duration: Annotated[
+        float | None,
+        typer.Option(
+            "--duration", help="Simulated s per episode (default follow 120, search 180)."
+        ),
+    ] = None,
+    vary: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--vary",
+            help="KEY=V1,V2,...: a mission key's values (YAML; @FILE reads one); repeatable.",
+        ),
+    ] = None,
+    workers: Annotated[
+        int | None,
+        typer.Option(
+            "--workers", help="Worker processes (default: the CPUs); with --ray local, its CPUs."
+        ),
+    ] = None,
+    ray: Annotated[
+        str | None,
+        typer.Option("--ray", help="Run as Ray tasks: auto, ray://HOST:PORT, or local."),
+    ] = None,
+    out: Annotated[
+        Path, typer.Option("--out", help="Folder for results.jsonl and the summary.")
+    ] = Path("out/bench"),
+    resume: Annotated[
+        bool,
+        typer.Option("--resume", help="Continue the campaign in --out; skip finished episodes."),
+    ] = False,
+    timeout: Annotated[
+        float | None,
+        typer.Option(
+            "--timeout",
+            help="Wall s before an episode is ended (default max(600, 10 x duration); 0: none).",
+        ),
+    ] = None,
+) -> None:
+    """Run seeded episodes of missions and variants; summarise each metric per variant."""
+    seconds = DEFAULT_DURATION.get(task, 120.0) if duration is None else duration
+    jobs = (os.cpu_count() or 1) if workers is None else workers
+    _check_options(task, episodes, jobs, seconds, timeout)
+    if ray is not None and ray != "local" and not ray.strip():
+        raise UserError("--ray: expected auto, ray://HOST:PORT or local")
+    if ray is not None and not ray_available():
+        raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
+    limit = max(600.0, 10 * seconds) if timeout is None else timeout
+    campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
+    records, writer = open_results(out, campaign, resume)
+    finished = {k for k, r in latest(records).items() if r["status"] == "ok"}
+    todo = [s for s in campaign.specs() if s.key not in finished]
+    total = len(campaign.specs())
+    console = Console(stderr=True)
+    where = (
+        f"Ray at {ray}" if ray is not None else f"{min(jobs, max(1, len(todo)))} worker processes"
+    )
+    console.print(
+        f"pfctl bench: {len(campaign.groups)} mission variant(s) × {episodes} episodes, "
+        f"{campaign.task} {seconds:g} s simulated; {total - len(todo)} done, {len(todo)} to run "
+        f"on {where}; results in {out / RESULTS_FILE}"
+    )
+    for name in BLAS_THREAD_VARIABLES:  # read by numpy in the workers spawned from here on
+        os.environ[name] = "1"
+    done = total - len(todo)
+    interrupted = died = False
+    started = time.perf_counter()
+    try:
+        with progress_bar(console, "episodes", len(todo)) as advance:
+
+            def on_record(record: dict[str, Any]) -> None:
+                nonlocal done
+                writer.append(record)
+                records.append(record)
+                done += 1
+                advance(1)
+                console.print(_episode_line(record, done, total), highlight=False)
+
+            if ray is not None:
+                run_on_ray(todo, ray, jobs, on_record)
+            else:
+                run_in_processes(todo, jobs, on_record)
+    except KeyboardInterrupt:
+        interrupted = True
+    except WorkerDiedError as err:
+        died = True
+        console.print(f"pfctl: error: {err}")
+    finally:
+        writer.close()
+    wall = time.perf_counter() - started
+    ok = {k for k, r in latest(records).items() if r["status"] == "ok"}
+    left = len({s.key for s in campaign.specs()} - ok)
+    console.print(f"{len(todo)} episode(s) planned this run, {wall:.0f} s wall; {left} not done")
+    written = _write_summary(campaign, records, out, console)
+    console.print("wrote " + ", ".join(str(p) for p in [out / RESULTS_FILE, *written]))
+    if interrupted or died:
+        console.print(f"continue with: pfctl bench ... --out {out} --resume")
+        raise typer.Exit(130 if interrupted else 1)
+
+
+__all__ = ["bench", "build_campaign"]
