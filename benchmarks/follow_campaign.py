@@ -9,15 +9,18 @@ Run::
 
 For every mission (default: ``missions/house.yaml``, ``missions/house_no_prediction.yaml``
 and ``missions/house_no_waypoint_search.yaml``: the paper's episode and its two ablations) and
-every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), one worker process
-loads the mission, learns the target's profile in the simulator *with that seed* (the faces
-depend on the seed), runs the follower for ``--duration`` simulated seconds (default 120) with
-:func:`pfctl.commands.follow.run_sim_episode` and returns the episode's
+every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), one episode of
+``pfctl bench`` runs (:func:`pfctl.bench.episode.run_episode_task`): learn the target's profile in
+the simulator *with that seed* (the faces depend on the seed), run the follower for
+``--duration`` simulated seconds (default 120) and return the episode's
 :func:`~pfctl.core.episode_metrics.follow_metrics`. ``--jobs`` workers (default: the number of
-CPUs) run at once; each is a fresh process started with the ``spawn`` context (PyBullet
-connections must not be forked) with one BLAS/OpenMP thread. An episode that raises, dies or
-exceeds ``--timeout`` wall seconds becomes a row whose ``status`` is ``error`` (with the message);
-the other episodes go on. Ctrl-C stops the workers and still writes what finished.
+CPUs) run at once (:func:`pfctl.bench.runner.run_in_processes`): a fresh process per episode,
+started with the ``spawn`` context (PyBullet connections must not be forked), one BLAS/OpenMP
+thread. An episode that raises becomes a row whose ``status`` is ``error`` (with the message), one
+that runs past ``--timeout`` wall seconds is ended with status ``timeout``; the other episodes go
+on. Ctrl-C stops the workers and still writes what finished. ``pfctl bench`` runs the same
+episodes with resuming, ``--vary``, Ray and bootstrap intervals; this script keeps the view by
+re-acquisition method.
 
 It prints one line per finished episode and at the end, per mission: episodes (and errors), the
 mean following rate with its standard deviation and range, losses, re-acquisition success
@@ -50,16 +53,9 @@ import argparse  # noqa: E402
 import csv  # noqa: E402
 import json  # noqa: E402
 import math  # noqa: E402
-import multiprocessing as mp  # noqa: E402
 import platform  # noqa: E402
-import signal  # noqa: E402
 import sys  # noqa: E402
-import threading  # noqa: E402
 import time  # noqa: E402
-import traceback  # noqa: E402
-from collections import deque  # noqa: E402
-from dataclasses import dataclass  # noqa: E402
-from multiprocessing.connection import Connection, wait  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -100,173 +96,23 @@ FIELDS = (
 )
 
 
-@dataclass(frozen=True)
-class Task:
-    """One episode to run: a mission file (and its label in the tables) and a seed."""
-
-    label: str
-    path: str
-    seed: int
-    duration: float
+# -- episode rows ---------------------------------------------------------------------------------
 
 
-# -- the worker (a spawned process) ---------------------------------------------------------------
-
-
-def run_episode(task: Task) -> dict[str, Any]:
-    """Learn the target with ``task.seed``, run one follow episode, return its metric row."""
-    from rich.console import Console
-
-    from pfctl.commands.follow import _profile, _sim_robot, run_sim_episode
-    from pfctl.core.episode_metrics import MetricParams, follow_metrics
-    from pfctl.mission import load_mission
-
-    mission = load_mission(task.path)
-    console = Console(stderr=True, quiet=True)
-    start = time.perf_counter()
-    profile = _profile(mission, None, task.seed, console, task.path)
-    learn_s = time.perf_counter() - start
-    robot = _sim_robot(mission, task.seed, False, task.path)
-    with robot:
-        result = run_sim_episode(mission, robot, profile, task.duration)
-    lo, hi = mission.control.following_band
-    metrics = follow_metrics(result.log, MetricParams(band=(lo, hi)))
-    refinds = [r.time_to_refind for r in metrics.reacquisitions]
-    ticks = 1000.0 * np.asarray(result.tick_seconds, dtype=float)
-    row: dict[str, Any] = {
-        "mission": task.label,
-        "seed": task.seed,
-        "status": "ok",
-        "error": "",
-        "following_rate": metrics.following_rate,
-        "first_identified_s": metrics.first_identified_s,
-        "losses": metrics.losses,
-        "reacquired": len(metrics.reacquisitions),
-        "unrecovered_losses": metrics.unrecovered_losses,
-        "median_time_to_refind_s": metrics.median_time_to_refind_s,
-        "refind_times_s": refinds,
-        "identity_switches": metrics.identity_switches,
-        "collisions": metrics.collisions,
-        "distance_m": metrics.distance_m,
-        "duration_s": metrics.duration_s,
-        "sim_time_s": result.sim_time,
-        "wall_time_s": result.wall_time,
-        "learn_wall_s": learn_s,
-        "tick_ms_median": float(np.median(ticks)) if len(ticks) else None,
-        "tick_ms_p99": float(np.percentile(ticks, 99)) if len(ticks) else None,
-    }
-    for how in HOW:
-        row[f"by_{how}"] = sum(r.how == how for r in metrics.reacquisitions)
-    return row
-
-
-def error_row(task: Task, message: str) -> dict[str, Any]:
-    """The row of an episode that did not finish."""
+def record_row(record: dict[str, Any]) -> dict[str, Any]:
+    """A ``pfctl bench`` episode record as a row of ``episodes.csv`` (:data:`FIELDS`)."""
     row: dict[str, Any] = dict.fromkeys(FIELDS)
-    row.update(mission=task.label, seed=task.seed, status="error", error=message)
-    return row
-
-
-def _exit_with_parent(parent: int) -> None:
-    """End this worker at once if the campaign process that started it goes away."""
-
-    def watch() -> None:
-        while True:
-            time.sleep(2.0)
-            if os.getppid() != parent:
-                os._exit(3)
-
-    threading.Thread(target=watch, name="parent-watch", daemon=True).start()
-
-
-def _worker(task: Task, conn: Connection, parent: int) -> None:
-    """Process entry point: run ``task`` and send its row (an error row if it raised)."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent handles Ctrl-C
-    _exit_with_parent(parent)
-    try:
-        row = run_episode(task)
-    except BaseException as err:  # any failure becomes an error row
-        last = traceback.extract_tb(err.__traceback__)[-1:] if err.__traceback__ else []
-        where = f" ({Path(last[0].filename).name}:{last[0].lineno})" if last else ""
-        row = error_row(task, f"{type(err).__name__}: {err}{where}".replace("\n", " "))
-    try:
-        conn.send(row)
-        conn.close()
-    except OSError:  # the campaign is gone: nobody to tell
-        pass
-
-
-# -- the scheduler --------------------------------------------------------------------------------
-
-
-@dataclass
-class _Running:
-    task: Task
-    proc: Any  # multiprocessing.context.SpawnProcess
-    conn: Connection
-    started: float
-
-
-def run_campaign(
-    tasks: list[Task], jobs: int, timeout: float, on_row: Any, start_method: str = "spawn"
-) -> list[dict[str, Any]]:
-    """Run ``tasks`` in at most ``jobs`` fresh processes at once; ``on_row(row)`` as each ends.
-
-    Each episode gets its own process (no state, memory or PyBullet connection carried over);
-    a process that dies without answering or runs longer than ``timeout`` wall seconds (0: no
-    limit) yields an error row. Ctrl-C kills the running workers and returns what finished.
-    """
-    ctx = mp.get_context(start_method)
-    pending = deque(tasks)
-    running: list[_Running] = []
-    rows: list[dict[str, Any]] = []
-
-    def finish(job: _Running, row: dict[str, Any]) -> None:
-        running.remove(job)
-        job.conn.close()
-        job.proc.join(timeout=10)
-        if job.proc.is_alive():
-            job.proc.kill()
-            job.proc.join()
-        rows.append(row)
-        on_row(row)
-
-    try:
-        while pending or running:
-            while pending and len(running) < jobs:
-                task = pending.popleft()
-                recv, send = ctx.Pipe(duplex=False)
-                # not daemonic: an episode starts its own face worker process (daemonic
-                # processes may not have children); _exit_with_parent and the kills below end it
-                proc = ctx.Process(target=_worker, args=(task, send, os.getpid()), daemon=False)
-                proc.start()
-                send.close()  # the child holds the only write end: EOF when it dies
-                running.append(_Running(task, proc, recv, time.monotonic()))
-            ready = wait([job.conn for job in running], timeout=1.0)
-            for job in [j for j in running if j.conn in ready]:
-                try:
-                    row = job.conn.recv()
-                except (EOFError, OSError):
-                    job.proc.join(timeout=10)
-                    code = job.proc.exitcode
-                    row = error_row(job.task, f"worker died (exit code {code})")
-                finish(job, row)
-            if timeout > 0:
-                now = time.monotonic()
-                for job in [j for j in running if now - j.started > timeout]:
-                    job.proc.kill()
-                    finish(job, error_row(job.task, f"timed out after {timeout:g} s wall"))
-    except KeyboardInterrupt:
-        for job in running:
-            job.proc.kill()
-        for job in running:
-            job.proc.join()
-            job.conn.close()
-        print(
-            f"interrupted: {len(running)} running and {len(pending)} pending episodes dropped",
-            file=sys.stderr,
-        )
-    return rows
+    row.update(mission=record["mission"], seed=record["seed"], status=record["status"])
+    row["error"] = record["error"] or ""
+    row.update(record["metrics"] or {})
+    timing = record["timing"] or {}
+    row.update(
+        wall_time_s=timing.get("episode_wall_s"),
+        learn_wall_s=timing.get("learn_wall_s"),
+        tick_ms_median=timing.get("tick_ms_median"),
+        tick_ms_p99=timing.get("tick_ms_p99"),
+    )
+    return {k: row[k] for k in FIELDS}
 
 
 # -- summary --------------------------------------------------------------------------------------
@@ -473,12 +319,6 @@ def _sha1(path: str) -> str:
     return hashlib.sha1(Path(path).read_bytes()).hexdigest()
 
 
-def _labels(paths: list[str]) -> list[str]:
-    """File stems, or the paths themselves when two stems collide."""
-    stems = [Path(p).stem for p in paths]
-    return stems if len(set(stems)) == len(stems) else list(paths)
-
-
 def main(argv: list[str] | None = None) -> int:
     """Parse the arguments, run the campaign, print and write the results; the exit status."""
     parser = argparse.ArgumentParser(
@@ -518,15 +358,27 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     timeout = max(600.0, 10 * args.duration) if args.timeout is None else args.timeout
 
-    labels = _labels(paths)
+    from pfctl.bench.runner import WorkerDiedError, run_in_processes
+    from pfctl.commands.bench import build_campaign
+
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    # Seed-major order: a campaign cut short still compares the missions on the same seeds.
-    tasks = [
-        Task(label, path, seed, args.duration)
-        for seed in seeds
-        for label, path in zip(labels, paths, strict=True)
-    ]
-    jobs = min(args.jobs, len(tasks))
+    try:
+        campaign = build_campaign(
+            [Path(p) for p in paths],
+            "follow",
+            args.seeds,
+            args.first_seed,
+            args.duration,
+            [],
+            timeout,
+        )
+    except UserError as err:
+        print(err, file=sys.stderr)
+        return 2
+    labels = [g.label for g in campaign.groups]  # one group per mission: no variants
+    paths = [g.path for g in campaign.groups]
+    specs = campaign.specs()  # seed-major: a campaign cut short compares missions on the same seeds
+    jobs = min(args.jobs, len(specs))
     print(
         f"follow campaign: {len(paths)} mission(s) × {len(seeds)} seeds "
         f"({seeds[0]}..{seeds[-1]}), {args.duration:g} s simulated each, {jobs} workers; "
@@ -539,29 +391,33 @@ def main(argv: list[str] | None = None) -> int:
     digests = {label: _sha1(path) for label, path in zip(labels, paths, strict=True)}
     csv_path = args.out / "episodes.csv"
     started = time.perf_counter()
+    rows: list[dict[str, Any]] = []
     with csv_path.open("w", newline="") as f:
         writer = csv.DictWriter(f, fieldnames=FIELDS)
         writer.writeheader()
-        done = 0
 
-        def on_row(row: dict[str, Any]) -> None:
-            nonlocal done
-            done += 1
+        def on_record(record: dict[str, Any]) -> None:
+            row = record_row(record)
+            rows.append(row)
             writer.writerow({k: _csv_value(row.get(k)) for k in FIELDS})
             f.flush()
-            print(_progress_line(done, len(tasks), row), flush=True)
+            print(_progress_line(len(rows), len(specs), row), flush=True)
 
-        rows = run_campaign(tasks, jobs, timeout, on_row)
+        try:
+            run_in_processes(specs, jobs, on_record)
+        except (KeyboardInterrupt, WorkerDiedError) as err:
+            what = "interrupted" if isinstance(err, KeyboardInterrupt) else str(err)
+            print(f"{what}: {len(specs) - len(rows)} episodes not run", file=sys.stderr)
     wall = time.perf_counter() - started
 
-    order = {(t.label, t.seed): i for i, t in enumerate(tasks)}
+    order = {(t.mission_label, t.seed): i for i, t in enumerate(specs)}
     rows.sort(key=lambda r: order[(r["mission"], r["seed"])])
     with csv_path.open("w", newline="") as f:  # again, in task order
         writer = csv.DictWriter(f, fieldnames=FIELDS)
         writer.writeheader()
         writer.writerows({k: _csv_value(r.get(k)) for k in FIELDS} for r in rows)
     summary = {label: summarize([r for r in rows if r["mission"] == label]) for label in labels}
-    print(f"\n{len(rows)}/{len(tasks)} episodes in {wall:.0f} s wall")
+    print(f"\n{len(rows)}/{len(specs)} episodes in {wall:.0f} s wall")
     print_table(summary)
     report = {
         "config": {
@@ -572,7 +428,7 @@ def main(argv: list[str] | None = None) -> int:
             "timeout_s": timeout,
             "wall_s": wall,
             "finished": len(rows),
-            "planned": len(tasks),
+            "planned": len(specs),
             "git": git,
             "mission_sha1": digests,
         },
