@@ -242,7 +242,8 @@ def bench(
     left = len({s.key for s in campaign.specs()} - ok)
     console.print(f"{len(todo)} episode(s) planned this run, {wall:.0f} s wall; {left} not done")
     written = _write_summary(campaign, records, out, console)
-    console.print("wrote " + ", ".join(str(p) for p in [out / RESULTS_FILE, *written]))
+    results = [out / RESULTS_FILE] if (out / RESULTS_FILE).exists() else []
+    console.print("wrote " + ", ".join(str(p) for p in [*results, *written]))
     if interrupted or died:
         console.print(f"continue with: pfctl bench ... --out {out} --resume")
         raise typer.Exit(130 if interrupted else 1)
