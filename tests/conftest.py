@@ -9,7 +9,9 @@ import pytest
 
 from pfctl import cli
 from pfctl.core.house import HouseLayout
-from pfctl.mission import load_mission
+from pfctl.core.planning import GridPlanner
+from pfctl.core.walls import rasterize_house
+from pfctl.mission import Mission, load_mission
 
 HOUSE_MISSION = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 
@@ -18,6 +20,19 @@ HOUSE_MISSION = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 def layout() -> HouseLayout:
     """The region map, doors and furniture of ``missions/house.yaml``."""
     return load_mission(HOUSE_MISSION).layout()
+
+
+@pytest.fixture(scope="module")
+def mission() -> Mission:
+    """``missions/house.yaml`` (a test module may define its own ``mission``)."""
+    return load_mission(HOUSE_MISSION)
+
+
+@pytest.fixture(scope="module")
+def planner(mission: Mission) -> GridPlanner:
+    """The grid planner of ``mission``'s house (walls rasterised) for the robot's radius."""
+    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
+    return GridPlanner(grid, mission.robot.radius)
 
 
 def run_cli(

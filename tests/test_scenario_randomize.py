@@ -12,22 +12,10 @@ import yaml
 
 from pfctl.backends.pybullet.walkers import PERSON_RADIUS, make_walkers
 from pfctl.core.planning import GridPlanner
-from pfctl.core.walls import rasterize_house
 from pfctl.errors import MissionError
-from pfctl.mission import Mission, ScenarioConfig, load_mission, loads_mission
+from pfctl.mission import Mission, ScenarioConfig, loads_mission
 
 HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
-
-
-@pytest.fixture(scope="module")
-def mission() -> Mission:
-    return load_mission(HOUSE)
-
-
-@pytest.fixture(scope="module")
-def planner(mission: Mission) -> GridPlanner:
-    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
-    return GridPlanner(grid, mission.robot.radius)
 
 
 def _with(mission: Mission, **randomize: Any) -> Mission:

@@ -3,31 +3,17 @@
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import numpy as np
-import pytest
 import shapely
 
 from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
 from pfctl.core.planning import GridPlanner
 from pfctl.core.robot import NavStatus, Pose2D, Twist2D
-from pfctl.core.walls import rasterize_house, wall_footprint
-from pfctl.mission import Mission, load_mission
+from pfctl.core.walls import wall_footprint
+from pfctl.mission import Mission
 
-HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 DT = 0.1
-
-
-@pytest.fixture(scope="module")
-def mission() -> Mission:
-    return load_mission(HOUSE)
-
-
-@pytest.fixture(scope="module")
-def planner(mission: Mission) -> GridPlanner:
-    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
-    return GridPlanner(grid, mission.robot.radius)
 
 
 def _navigator(mission: Mission, planner: GridPlanner) -> Navigator:

@@ -2,30 +2,16 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 import shapely
 
 from pfctl.backends.pybullet.walkers import LEG_RADIUS, PERSON_RADIUS, make_walkers
 from pfctl.core.planning import GridPlanner
-from pfctl.core.walls import rasterize_house, wall_footprint
-from pfctl.mission import Mission, ScenarioConfig, load_mission
+from pfctl.core.walls import wall_footprint
+from pfctl.mission import Mission, ScenarioConfig
 
-HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 DT = 0.05
-
-
-@pytest.fixture(scope="module")
-def mission() -> Mission:
-    return load_mission(HOUSE)
-
-
-@pytest.fixture(scope="module")
-def planner(mission: Mission) -> GridPlanner:
-    grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
-    return GridPlanner(grid, mission.robot.radius)
 
 
 def _run(mission: Mission, planner: GridPlanner, seed: int, seconds: float) -> dict:
