@@ -8,7 +8,7 @@ Run::
     .venv/bin/python benchmarks/bench_follower.py --profile             # + cProfile of the ticks
 
 It learns the target in the simulator (not timed), then runs the follower
-(:func:`pfctl.commands.follow.run_sim_episode`) for ``--duration`` simulated seconds (default
+(:func:`pfctl.sim_episode.run_sim_episode`) for ``--duration`` simulated seconds (default
 60) **the way a robot runs it**: the face searches of Algorithm 2 (dlib's HOG detector and ResNet
 embedding, ~75–90 ms per face) go to a :class:`~pfctl.core.face_worker.FaceWorker` process with
 ``realtime`` timing (results are folded in when they are back, the tick never waits), and the
@@ -378,12 +378,12 @@ def run_once(
     worker (closed; its stats kept) and the pacer."""
     from rich.console import Console
 
-    from pfctl.commands.follow import _profile, _sim_robot, run_sim_episode
     from pfctl.core.face_worker import FaceWorker
     from pfctl.perception_setup import identity_params
+    from pfctl.sim_episode import run_sim_episode, sim_robot, target_profile
 
-    profile = _profile(mission, None, seed, Console(stderr=True), source)
-    robot = _sim_robot(mission, seed, False, source)
+    profile = target_profile(mission, None, seed, Console(stderr=True), source)
+    robot = sim_robot(mission, seed, False, source)
     worker = None
     if not mode.sync and len(profile.faces):
         # the loop is pinned to CPU 0: the worker too, at the lowest priority

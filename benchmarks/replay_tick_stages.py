@@ -63,13 +63,13 @@ def record(path: Path, duration: float) -> None:
     """Run the crowd episode and pickle what the follower perceived."""
     from rich.console import Console
 
-    from pfctl.commands.follow import _profile, _sim_robot, run_sim_episode
     from pfctl.core import follower as follower_mod
     from pfctl.mission import load_mission
+    from pfctl.sim_episode import run_sim_episode, sim_robot, target_profile
 
     mission = load_mission(CROWD)
-    profile = _profile(mission, None, None, Console(stderr=True), str(CROWD))
-    robot = _sim_robot(mission, None, False, str(CROWD))
+    profile = target_profile(mission, None, None, Console(stderr=True), str(CROWD))
+    robot = sim_robot(mission, None, False, str(CROWD))
     kept: dict[str, Any] = {"observations": [], "profile": profile}
     original = follower_mod.Follower._perceive
 

@@ -101,7 +101,7 @@ def test_look_alikes_need_a_target_and_hide_in_names_regions() -> None:
 
 def test_search_hides_the_target_in_one_of_hide_in(mission: Mission) -> None:
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-    from pfctl.commands.follow import hide_target
+    from pfctl.sim_episode import hide_target
 
     varied = _with(mission, hide_in=["bedroom", "living_room"])
     seen = set()

@@ -116,16 +116,16 @@ def run_episode_task(spec: EpisodeSpec) -> dict[str, Any]:
 def _run(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[str, Any]]:
     from rich.console import Console
 
-    from pfctl.commands.follow import _profile, _sim_robot, hide_target, run_sim_episode
     from pfctl.core.episode_metrics import MetricParams, follow_metrics, search_metrics
+    from pfctl.sim_episode import hide_target, run_sim_episode, sim_robot, target_profile
 
     mission = spec.mission
     source = f"{spec.mission_file} [{spec.variant}]"
     start = time.perf_counter()
     deadline = start + spec.timeout if spec.timeout > 0 else math.inf
-    profile = _profile(mission, None, spec.seed, Console(stderr=True, quiet=True), source)
+    profile = target_profile(mission, None, spec.seed, Console(stderr=True, quiet=True), source)
     learn_s = time.perf_counter() - start
-    robot = _sim_robot(mission, spec.seed, False, source)
+    robot = sim_robot(mission, spec.seed, False, source)
     region = None
     with robot:
         if spec.task == "search":

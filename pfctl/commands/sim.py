@@ -411,7 +411,7 @@ def _serve(
     with robot:
         scene = None
         if hide is not None:
-            from pfctl.commands.follow import hide_target
+            from pfctl.sim_episode import hide_target
 
             hide_target(robot, hide)
         elif pose_target:

@@ -13,13 +13,13 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.follow import LEARN_SECONDS, run_sim_episode
 from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
 from pfctl.core.episode import TickRecord
 from pfctl.core.identity import TargetProfile, learn_profile
 from pfctl.mission import load_mission
 from pfctl.perception_setup import identity_params
+from pfctl.sim_episode import LEARN_SECONDS, run_sim_episode
 
 MISSIONS = Path(__file__).resolve().parents[2] / "missions"
 SEED = 1

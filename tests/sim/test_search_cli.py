@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.follow import hide_target
 from pfctl.mission import load_mission
+from pfctl.sim_episode import hide_target
 
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = ROOT / "missions" / "house.yaml"
