@@ -1386,17 +1386,9 @@ def _read_layers(
         root.end_mark,
         root.flow_style,
     )
-    if not isinstance(value, str) or not value.strip():
-        raise MissionError(
-            f"{where}: expected the path of the mission this one extends (relative to this "
-            f"file), got {_got(value)}"
-        )
-    base_file = Path(value) if Path(value).is_absolute() else base_dir / value
-    if not base_file.is_file():
-        raise MissionError(
-            f"{where}: expected an existing mission file, but {os.path.normpath(base_file)} "
-            + ("is a directory" if base_file.is_dir() else "does not exist")
-        )
+    base_file = _referenced_file(
+        value, base_dir, where, "the path of the mission this one extends", "mission file"
+    )
     resolved = base_file.resolve()
     names = [name for _, name in chain] or [source]
     if any(resolved == seen for seen, _ in chain):
@@ -1412,6 +1404,22 @@ def _read_layers(
     merged_root = _merge_nodes(base_root, root, ())
     assert isinstance(merged_root, yaml.MappingNode)
     return merged_root, merge_mission_data(base_data, data), [*sources, *base_sources]
+
+
+def _referenced_file(value: object, base_dir: Path, where: str, expected: str, kind: str) -> Path:
+    """The existing file a mission names at ``where`` (``extends``, a tree ``include``): an
+    absolute path, or one relative to the naming file's folder ``base_dir``; else one line."""
+    if not isinstance(value, str) or not value.strip():
+        raise MissionError(
+            f"{where}: expected {expected} (relative to this file), got {_got(value)}"
+        )
+    file = Path(value) if Path(value).is_absolute() else base_dir / value
+    if not file.is_file():
+        raise MissionError(
+            f"{where}: expected an existing {kind}, but {os.path.normpath(file)} "
+            + ("is a directory" if file.is_dir() else "does not exist")
+        )
+    return file
 
 
 def _key_node(node: yaml.Node, key: str) -> yaml.ScalarNode | None:
@@ -1447,16 +1455,7 @@ def _include_tree(
             f"{where}: a tree read from a file takes no other keys, got {others[0]!r} beside it"
         )
     value = tree[INCLUDE_KEY]
-    if not isinstance(value, str) or not value.strip():
-        raise MissionError(
-            f"{where}: expected the path of a tree file (relative to this file), got {_got(value)}"
-        )
-    file = Path(value) if Path(value).is_absolute() else base_dir / value
-    if not file.is_file():
-        raise MissionError(
-            f"{where}: expected an existing tree file, but {os.path.normpath(file)} "
-            + ("is a directory" if file.is_dir() else "does not exist")
-        )
+    file = _referenced_file(value, base_dir, where, "the path of a tree file", "tree file")
     name = os.path.normpath(file)
     tree_root, tree_data = _parse_yaml(_read_text(file, name, "a behavior-tree YAML file"), name)
     if tree_root is None or tree_data is None:

@@ -16,6 +16,7 @@ from conftest import HOUSE_MISSION, run_cli
 
 from pfctl import cli
 from pfctl.bench import runner
+from pfctl.bench.episode import record_header
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.bench.results import RESULTS_FILE, read_records
 from pfctl.commands import bench as bench_command
@@ -28,13 +29,7 @@ def fake_record(spec: EpisodeSpec, status: str = "ok") -> dict[str, Any]:
     """What run_episode_task returns, with metrics made from the seed."""
     rate = 0.1 * (spec.seed % 7)
     return {
-        "mission": spec.mission_label,
-        "mission_file": spec.mission_file,
-        "variant": spec.variant,
-        "index": spec.index,
-        "seed": spec.seed,
-        "task": spec.task,
-        "config": spec.config,
+        **record_header(spec),
         "status": status,
         "error": None if status == "ok" else "RuntimeError: boom",
         "metrics": {

@@ -35,7 +35,13 @@ import numpy as np
 
 from pfctl.bench.plan import EpisodeSpec
 
-__all__ = ["BLAS_THREAD_VARIABLES", "error_record", "one_blas_thread", "run_episode_task"]
+__all__ = [
+    "BLAS_THREAD_VARIABLES",
+    "error_record",
+    "one_blas_thread",
+    "record_header",
+    "run_episode_task",
+]
 
 #: Environment variables that give numpy's BLAS / OpenMP one thread (read when it loads).
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
@@ -58,7 +64,8 @@ def _now() -> str:
     return dt.datetime.now(dt.timezone.utc).isoformat(timespec="milliseconds")
 
 
-def _header(spec: EpisodeSpec) -> dict[str, Any]:
+def record_header(spec: EpisodeSpec) -> dict[str, Any]:
+    """The fields of a record that name its episode (module docstring)."""
     return {
         "mission": spec.mission_label,
         "mission_file": spec.mission_file,
@@ -75,7 +82,7 @@ def error_record(
 ) -> dict[str, Any]:
     """The record of an episode that did not finish: ``status`` ``error`` and ``message``."""
     return {
-        **_header(spec),
+        **record_header(spec),
         "status": "error",
         "error": message,
         "metrics": None,
@@ -104,7 +111,7 @@ def run_episode_task(spec: EpisodeSpec) -> dict[str, Any]:
         return error_record(spec, message, run=run)
     run["finished"] = _now()
     return {
-        **_header(spec),
+        **record_header(spec),
         "status": status,
         "error": None if status == "ok" else "ended after the wall-clock timeout",
         "metrics": metrics,
