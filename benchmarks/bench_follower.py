@@ -8,13 +8,13 @@ Run::
     .venv/bin/python benchmarks/bench_follower.py --profile             # + cProfile of the ticks
 
 It learns the target in the simulator (not timed), then runs the follower
-(:func:`pfctl.sim_episode.run_sim_episode`) for ``--duration`` simulated seconds (default
+(:func:`pfctl.app.episodes.run_sim_episode`) for ``--duration`` simulated seconds (default
 60) **the way a robot runs it**: the face searches of Algorithm 2 (dlib's HOG detector and ResNet
-embedding, ~75–90 ms per face) go to a :class:`~pfctl.core.face_worker.FaceWorker` process with
-``realtime`` timing (results are folded in when they are back, the tick never waits), and the
-loop is paced in wall time at the mission's tick rate: after the tick and the simulator's step it
-sleeps until the next period, so the worker — pinned to the same CPU 0 and running at the lowest
-priority (nice 19, ``SCHED_IDLE``) — gets the idle time of the one core and the control loop
+embedding, ~75–90 ms per face) go to a :class:`~pfctl.core.perception.face_worker.FaceWorker`
+process with ``realtime`` timing (results are folded in when they are back, the tick never waits),
+and the loop is paced in wall time at the mission's tick rate: after the tick and the simulator's
+step it sleeps until the next period, so the worker — pinned to the same CPU 0 and running at the
+lowest priority (nice 19, ``SCHED_IDLE``) — gets the idle time of the one core and the control loop
 preempts it whenever it wakes. ``--sync`` searches faces inline in the tick instead (as before
 the worker); ``--timing deterministic`` uses the simulator's reproducible timing (the tick waits
 for a result that is due); ``--no-pace`` runs as fast as it can.
@@ -78,10 +78,10 @@ from typing import TYPE_CHECKING, Any, cast  # noqa: E402
 import numpy as np  # noqa: E402
 
 if TYPE_CHECKING:
+    from pfctl.app.follower import EpisodeResult
     from pfctl.backends.pybullet.simulation import SimRobot
-    from pfctl.core.face_worker import FaceWorker
+    from pfctl.core.perception.face_worker import FaceWorker
     from pfctl.core.robot import Observation
-    from pfctl.follow_session import EpisodeResult
     from pfctl.mission import Mission
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -91,21 +91,36 @@ GOAL_MS = 20.0
 #: The timed stages: (label, module, class or None for a module function, attribute).
 #: Indented labels run inside the stage above them; the unindented ones do not overlap.
 STAGES: tuple[tuple[str, str, str | None, str], ...] = (
-    ("laser perception (on_scan)", "pfctl.core.perception", "Perception", "on_scan"),
-    ("  leg detection", "pfctl.core.legs", "LegDetector", "detect"),
-    ("camera perception (on_frame)", "pfctl.core.perception", "Perception", "on_frame"),
-    ("  person detection (mask)", "pfctl.core.vision", "MaskPersonDetector", "detect"),
-    ("  identification (Alg. 2)", "pfctl.core.identity", "TargetIdentifier", "observe_frame"),
-    ("    faces inline: dlib detect+embed", "pfctl.core.faces", "FaceEncoder", "detect"),
-    ("    face worker: submit crop", "pfctl.core.face_worker", "FaceWorker", "submit"),
-    ("    face worker: poll", "pfctl.core.face_worker", "FaceWorker", "poll"),
-    ("    face worker: wait (deterministic)", "pfctl.core.face_worker", "FaceWorker", "wait"),
-    ("  belief update (Eq. 4)", "pfctl.core.belief", "HumanBelief", "update"),
-    ("tracking (in on_scan/on_frame)", "pfctl.core.tracking", "MultiPersonTracker", "update"),
-    ("occupancy grid (Eq. 1)", "pfctl.core.grid", "OccupancyGrid", "update_scan"),
+    ("laser perception (on_scan)", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
+    ("  leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
+    ("camera perception (on_frame)", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
+    ("  person detection (mask)", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
+    (
+        "  identification (Alg. 2)",
+        "pfctl.core.perception.identity.identifier",
+        "TargetIdentifier",
+        "observe_frame",
+    ),
+    ("    faces inline: dlib detect+embed", "pfctl.core.perception.faces", "FaceEncoder", "detect"),
+    ("    face worker: submit crop", "pfctl.core.perception.face_worker", "FaceWorker", "submit"),
+    ("    face worker: poll", "pfctl.core.perception.face_worker", "FaceWorker", "poll"),
+    (
+        "    face worker: wait (deterministic)",
+        "pfctl.core.perception.face_worker",
+        "FaceWorker",
+        "wait",
+    ),
+    ("  belief update (Eq. 4)", "pfctl.core.perception.belief", "HumanBelief", "update"),
+    (
+        "tracking (in on_scan/on_frame)",
+        "pfctl.core.perception.tracking",
+        "MultiPersonTracker",
+        "update",
+    ),
+    ("occupancy grid (Eq. 1)", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
     ("behavior tree (tick_once)", "py_trees.behaviour", "Behaviour", "tick_once"),
     ("  Algorithm 1 (next_waypoint)", "pfctl.core.behavior.skills", "Skills", "next_waypoint"),
-    ("  grid planner (plan)", "pfctl.core.planning", "GridPlanner", "plan"),
+    ("  grid planner (plan)", "pfctl.core.mapping.planning", "GridPlanner", "plan"),
     ("  robot calls (sim navigate, …)", "", None, ""),
     ("prediction (SVR, on loss)", "pfctl.core.follower", "Follower", "_predict"),
     ("gaze", "pfctl.core.follower", "Follower", "_gaze"),
@@ -266,9 +281,9 @@ def _clothes_measured(follower: Any) -> int:
 def _count_embeddings(clock: TickClock, patch: Callable[[Any, str, Any], None]) -> None:
     """Count the face work of a tick: the faces ``FaceEncoder.detect`` returns (each one was
     embedded inline) and the crops ``FaceWorker.submit`` accepts; note every identifier made."""
-    from pfctl.core.face_worker import FaceWorker
-    from pfctl.core.faces import FaceEncoder
-    from pfctl.core.identity import TargetIdentifier
+    from pfctl.core.perception.face_worker import FaceWorker
+    from pfctl.core.perception.faces import FaceEncoder
+    from pfctl.core.perception.identity.identifier import TargetIdentifier
 
     detect = FaceEncoder.__dict__["detect"]
     submit = FaceWorker.__dict__["submit"]
@@ -378,9 +393,9 @@ def run_once(
     worker (closed; its stats kept) and the pacer."""
     from rich.console import Console
 
-    from pfctl.core.face_worker import FaceWorker
-    from pfctl.perception_setup import identity_params
-    from pfctl.sim_episode import run_sim_episode, sim_robot, target_profile
+    from pfctl.app.episodes import run_sim_episode, sim_robot, target_profile
+    from pfctl.app.perception import identity_params
+    from pfctl.core.perception.face_worker import FaceWorker
 
     profile = target_profile(mission, None, seed, Console(stderr=True), source)
     robot = sim_robot(mission, seed, False, source)
@@ -659,7 +674,7 @@ def main() -> int:
 
     mode = Mode(sync=args.sync, timing=args.timing, pace=not args.no_pace)
     print(f"  mode    : {mode.describe()}")
-    from pfctl.core.allocation import retain_freed_memory
+    from pfctl.app.memory import retain_freed_memory
 
     kept = retain_freed_memory()  # as run_follower does for every episode
     print(f"  memory  : freed blocks kept in the heap (retain_freed_memory: {kept})")

@@ -40,16 +40,16 @@ import dlib  # noqa: E402
 import numpy as np  # noqa: E402
 
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
-from pfctl.core.clothes import convert  # noqa: E402
-from pfctl.core.faces import FaceEncoder  # noqa: E402
-from pfctl.core.identity import (  # noqa: E402
+from pfctl.core.perception.clothes import convert  # noqa: E402
+from pfctl.core.perception.faces import FaceEncoder  # noqa: E402
+from pfctl.core.perception.identity.identifier import (  # noqa: E402
     IdentityParams,
     TargetIdentifier,
     describe,
     learn_profile,
 )
+from pfctl.core.perception.vision import MaskPersonDetector  # noqa: E402
 from pfctl.core.robot import HeadTarget, RgbdFrame  # noqa: E402
-from pfctl.core.vision import MaskPersonDetector  # noqa: E402
 from pfctl.mission import loads_mission  # noqa: E402
 
 WARMUP = 3

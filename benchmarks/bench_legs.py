@@ -32,8 +32,13 @@ import numpy as np  # noqa: E402
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec  # noqa: E402
 from pfctl.backends.pybullet.leg_scans import LegScanGenerator  # noqa: E402
 from pfctl.backends.pybullet.walkers import HIP_WIDTH, LEG_RADIUS  # noqa: E402
-from pfctl.core.leg_features import segment_features, segment_scan  # noqa: E402
-from pfctl.core.legs import LegDetector, LegParams, describe_segments, load_leg_model  # noqa: E402
+from pfctl.core.perception.legs.detector import (  # noqa: E402
+    LegDetector,
+    LegParams,
+    describe_segments,
+    load_leg_model,
+)
+from pfctl.core.perception.legs.features import segment_features, segment_scan  # noqa: E402
 from pfctl.core.robot import LaserScan, Pose2D  # noqa: E402
 from pfctl.mission import load_mission  # noqa: E402
 

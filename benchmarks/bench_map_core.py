@@ -32,11 +32,11 @@ import shapely  # noqa: E402
 from shapely.geometry import LineString  # noqa: E402
 from shapely.ops import unary_union  # noqa: E402
 
-from pfctl.core.frontiers import find_frontiers, frontier_map, trinary_map  # noqa: E402
-from pfctl.core.grid import OCCUPIED, UNKNOWN, GridGeometry, OccupancyGrid  # noqa: E402
-from pfctl.core.house import Door, HouseLayout, Obstacle, Region  # noqa: E402
-from pfctl.core.paths import distance_fields, traversability  # noqa: E402
-from pfctl.core.regions import RegionMap, waypoint_search  # noqa: E402
+from pfctl.core.mapping.frontiers import find_frontiers, frontier_map, trinary_map  # noqa: E402
+from pfctl.core.mapping.grid import OCCUPIED, UNKNOWN, GridGeometry, OccupancyGrid  # noqa: E402
+from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region  # noqa: E402
+from pfctl.core.mapping.paths import distance_fields, traversability  # noqa: E402
+from pfctl.core.mapping.regions import RegionMap, waypoint_search  # noqa: E402
 
 SIZE_M = 20.0
 RES = 0.05

@@ -29,9 +29,9 @@ import pybullet as p  # noqa: E402
 from pfctl.backends.pybullet.navigation import Navigator  # noqa: E402
 from pfctl.backends.pybullet.people_bodies import PeopleBodies  # noqa: E402
 from pfctl.backends.pybullet.walkers import make_walkers  # noqa: E402
-from pfctl.core.planning import GridPlanner  # noqa: E402
+from pfctl.core.mapping.planning import GridPlanner  # noqa: E402
+from pfctl.core.mapping.walls import rasterize_house  # noqa: E402
 from pfctl.core.robot import Pose2D  # noqa: E402
-from pfctl.core.walls import rasterize_house  # noqa: E402
 from pfctl.mission import ScenarioConfig, load_mission  # noqa: E402
 
 HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"

@@ -1,11 +1,12 @@
 """Speed of the laser perception per scan on one CPU core: leg detection + tracking, 10 people.
 
 Run ``python benchmarks/bench_perception.py [--runs N]``. It feeds the 1081-beam crowd scan of
-``bench_legs.py`` (10 people 1–5 m ahead) to :meth:`pfctl.core.perception.Perception.on_scan`
-at 40 Hz stamps — leg detection with the shipped model, then the tracker's predict, Hungarian
-association and Kalman updates — and prints the median and 90th percentile in milliseconds after
-the ten tracks are confirmed. Goal (issue 5): under 3 ms a scan. The belief update is timed by
-``bench_tracking_belief.py``. It asserts nothing about time.
+``bench_legs.py`` (10 people 1–5 m ahead) to
+:meth:`pfctl.core.perception.pipeline.Perception.on_scan` at 40 Hz stamps — leg detection with the
+shipped model, then the tracker's predict, Hungarian association and Kalman updates — and prints the
+median and 90th percentile in milliseconds after the ten tracks are confirmed. Goal (issue 5): under
+3 ms a scan. The belief update is timed by ``bench_tracking_belief.py``. It asserts nothing about
+time.
 """
 
 from __future__ import annotations
@@ -26,8 +27,8 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 from bench_legs import crowd_scan  # noqa: E402
 
+from pfctl.app.perception import build_perception  # noqa: E402
 from pfctl.mission import load_mission  # noqa: E402
-from pfctl.perception_setup import build_perception  # noqa: E402
 
 HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 

@@ -26,7 +26,7 @@ import time  # noqa: E402
 import numpy as np  # noqa: E402
 import sklearn  # noqa: E402
 
-from pfctl.core.prediction import MODELS, make_model  # noqa: E402
+from pfctl.core.prediction.models import MODELS, make_model  # noqa: E402
 
 HISTORY_S = 3.0
 RATES_HZ = (10.0, 40.0)

@@ -32,7 +32,7 @@ from typing import Any  # noqa: E402
 
 from pfctl.backends.pybullet import simulation  # noqa: E402
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
-from pfctl.core.regions import RegionMap  # noqa: E402
+from pfctl.core.mapping.regions import RegionMap  # noqa: E402
 from pfctl.core.robot import NavStatus, Pose2D  # noqa: E402
 from pfctl.mission import Mission, ScenarioConfig, load_mission  # noqa: E402
 

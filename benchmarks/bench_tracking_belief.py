@@ -40,17 +40,17 @@ import filterpy  # noqa: E402
 import numpy as np  # noqa: E402
 import scipy  # noqa: E402
 
-from pfctl.core.belief import BeliefParams, HumanBelief, visible_mask  # noqa: E402
-from pfctl.core.grid import FREE, OCCUPIED  # noqa: E402
-from pfctl.core.robot import Pose2D  # noqa: E402
-from pfctl.core.tracking import (  # noqa: E402
+from pfctl.core.mapping.grid import FREE, OCCUPIED  # noqa: E402
+from pfctl.core.mapping.walls import rasterize_house  # noqa: E402
+from pfctl.core.perception.belief import BeliefParams, HumanBelief, visible_mask  # noqa: E402
+from pfctl.core.perception.tracking import (  # noqa: E402
     LASER,
     Detection,
     FieldOfView,
     MultiPersonTracker,
     TrackerParams,
 )
-from pfctl.core.walls import rasterize_house  # noqa: E402
+from pfctl.core.robot import Pose2D  # noqa: E402
 from pfctl.mission import load_mission  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

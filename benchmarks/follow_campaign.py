@@ -13,7 +13,7 @@ every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), 
 ``pfctl bench`` runs (:func:`pfctl.bench.episode.run_episode_task`): learn the target's profile in
 the simulator *with that seed* (the faces depend on the seed), run the follower for
 ``--duration`` simulated seconds (default 120) and return the episode's
-:func:`~pfctl.core.episode_metrics.follow_metrics`. ``--jobs`` workers (default: the number of
+:func:`~pfctl.core.metrics.follow_metrics`. ``--jobs`` workers (default: the number of
 CPUs) run at once (:func:`pfctl.bench.runner.run_in_processes`): a fresh process per episode,
 started with the ``spawn`` context (PyBullet connections must not be forked), one BLAS/OpenMP
 thread. An episode that raises becomes a row whose ``status`` is ``error`` (with the message), one

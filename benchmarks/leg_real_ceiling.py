@@ -8,8 +8,10 @@ what other classifiers, temporal evidence and other splits reach on the same seg
 the gap is a measured fact rather than a guess.
 
 Run ``python benchmarks/leg_real_ceiling.py [--data ../shared/data/legs]`` (about 1 minute on
-two cores). Segments are those of :func:`pfctl.core.legs.describe_segments` with the shipped
-:class:`~pfctl.core.legs.LegParams`, labelled as :mod:`pfctl.leg_data` labels them (positives:
+two cores). Segments are those of
+:func:`pfctl.core.perception.legs.detector.describe_segments` with the shipped
+:class:`~pfctl.core.perception.legs.detector.LegParams`, labelled as :mod:`pfctl.app.leg_data`
+labels them (positives:
 segments at a labelled leg position inside each bag's labelled arc; negatives: every segment of
 ``negative_2.bag``). Only real scans are used for training: simulated scans lower the real
 figures (measured in the closing note of issue 5).
@@ -46,11 +48,17 @@ from pathlib import Path
 import numpy as np
 from sklearn.ensemble import HistGradientBoostingClassifier, RandomForestClassifier
 
-from pfctl.bags import open_bag
-from pfctl.core.leg_evidence import LegEvidence
-from pfctl.core.leg_training import EVAL_BAND, IGNORE, MAX_DEPTH, MIN_SAMPLES_LEAF, N_TREES
-from pfctl.core.legs import LegParams, describe_segments
-from pfctl.leg_data import SCAN_TOPIC, real_bags, real_sequences
+from pfctl.app.leg_data import SCAN_TOPIC, real_bags, real_sequences
+from pfctl.bags.reading import open_bag
+from pfctl.core.perception.legs.detector import LegParams, describe_segments
+from pfctl.core.perception.legs.evidence import LegEvidence
+from pfctl.core.perception.legs.training import (
+    EVAL_BAND,
+    IGNORE,
+    MAX_DEPTH,
+    MIN_SAMPLES_LEAF,
+    N_TREES,
+)
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "legs"
 #: A segment of a stationary laser's scan is static background when every return is this close
@@ -79,7 +87,8 @@ class Segments:
 
 def static_background(path: Path, params: LegParams) -> list[np.ndarray]:
     """Per scan of a positive bag, which of its classified segments (in
-    :func:`~pfctl.core.leg_training.scan_segments` order) lie on the static background."""
+    :func:`~pfctl.core.perception.legs.training.scan_segments` order) lie on the static
+    background."""
     with open_bag(path) as bag:
         scans = [scan for _, scan in bag.scans(SCAN_TOPIC)]
     ranges = np.array([np.where(np.isfinite(s.ranges), s.ranges, 1e3) for s in scans])
@@ -155,7 +164,7 @@ def out_of_fold(
 
 def track_mean(data: Segments, prob: np.ndarray, history: int) -> np.ndarray:
     """Each segment's P(leg) averaged over its track's last ``history`` scans
-    (:class:`~pfctl.core.leg_evidence.LegEvidence`, laser frame)."""
+    (:class:`~pfctl.core.perception.legs.evidence.LegEvidence`, laser frame)."""
     out = prob.copy()
     for g in np.unique(data.group):
         evidence = LegEvidence(history)

@@ -8,8 +8,8 @@ Run::
 ``--record`` runs the crowd mission (``missions/house_crowd.yaml``, seed 7, 60 s, unpaced, faces
 searched inline) and keeps every observation the follower perceived, the person detector and the
 belief it started with and the target profile. The replay feeds the same scans and frames, in
-order, to a fresh :class:`~pfctl.core.perception.Perception` (the identifier without faces: the
-live run's face results depend on timing) and an occupancy grid, then asks the belief for the
+order, to a fresh :class:`~pfctl.core.perception.pipeline.Perception` (the identifier without faces:
+the live run's face results depend on timing) and an occupancy grid, then asks the belief for the
 gaze's peaks, as the follower's tick does, ``--repeats`` times (default 5). Per stage and call
 it keeps the smallest CPU time (``time.thread_time``) over the repeats — the replay is
 deterministic, so call i is the same work in every repeat and the minimum strips most of what a
@@ -44,18 +44,23 @@ CROWD = ROOT / "missions" / "house_crowd.yaml"
 
 #: (label, module, class, method) timed in the replay; indented labels run inside the one above.
 STAGES: tuple[tuple[str, str, str, str], ...] = (
-    ("on_scan", "pfctl.core.perception", "Perception", "on_scan"),
-    ("  leg detection", "pfctl.core.legs", "LegDetector", "detect"),
-    ("    features", "pfctl.core.legs", "", "describe_segments"),
-    ("    forest", "pfctl.core.leg_model", "LegModel", "predict_proba"),
-    ("    evidence", "pfctl.core.leg_evidence", "LegEvidence", "update"),
-    ("  tracking", "pfctl.core.tracking", "MultiPersonTracker", "update"),
-    ("on_frame", "pfctl.core.perception", "Perception", "on_frame"),
-    ("  person detection", "pfctl.core.vision", "MaskPersonDetector", "detect"),
-    ("  identification", "pfctl.core.identity", "TargetIdentifier", "observe_frame"),
-    ("  belief update", "pfctl.core.belief", "HumanBelief", "update"),
-    ("grid update", "pfctl.core.grid", "OccupancyGrid", "update_scan"),
-    ("belief most_likely", "pfctl.core.belief", "HumanBelief", "most_likely"),
+    ("on_scan", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
+    ("  leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
+    ("    features", "pfctl.core.perception.legs.detector", "", "describe_segments"),
+    ("    forest", "pfctl.core.perception.legs.model", "LegModel", "predict_proba"),
+    ("    evidence", "pfctl.core.perception.legs.evidence", "LegEvidence", "update"),
+    ("  tracking", "pfctl.core.perception.tracking", "MultiPersonTracker", "update"),
+    ("on_frame", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
+    ("  person detection", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
+    (
+        "  identification",
+        "pfctl.core.perception.identity.identifier",
+        "TargetIdentifier",
+        "observe_frame",
+    ),
+    ("  belief update", "pfctl.core.perception.belief", "HumanBelief", "update"),
+    ("grid update", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
+    ("belief most_likely", "pfctl.core.perception.belief", "HumanBelief", "most_likely"),
 )
 
 
@@ -63,9 +68,9 @@ def record(path: Path, duration: float) -> None:
     """Run the crowd episode and pickle what the follower perceived."""
     from rich.console import Console
 
+    from pfctl.app.episodes import run_sim_episode, sim_robot, target_profile
     from pfctl.core import follower as follower_mod
     from pfctl.mission import load_mission
-    from pfctl.sim_episode import run_sim_episode, sim_robot, target_profile
 
     mission = load_mission(CROWD)
     profile = target_profile(mission, None, None, Console(stderr=True), str(CROWD))
@@ -115,7 +120,7 @@ def timed(times: dict[str, list[float]]) -> Iterator[None]:
         setattr(owner, name, wrapper)
         undo.append(lambda o=owner, n=name, f=fn: setattr(o, n, f))
         if not cls:  # a module function imported by name elsewhere
-            legs = importlib.import_module("pfctl.core.legs")
+            legs = importlib.import_module("pfctl.core.perception.legs.detector")
             if getattr(legs, name, None) is fn:
                 setattr(legs, name, wrapper)
                 undo.append(lambda m=legs, n=name, f=fn: setattr(m, n, f))
@@ -128,15 +133,15 @@ def timed(times: dict[str, list[float]]) -> Iterator[None]:
 
 def replay_once(kept: dict[str, Any]) -> tuple[dict[str, list[float]], list[float], Any]:
     """One replay: per-stage call times, per-observation total, and the outputs (for checks)."""
+    from pfctl.app.perception import build_perception
     from pfctl.core.control import KNOWN_RADIUS
     from pfctl.core.follower import PEAK_CANDIDATES
     from pfctl.mission import load_mission
-    from pfctl.perception_setup import build_perception
 
     mission = load_mission(CROWD)
     perception = build_perception(mission, detector=copy.deepcopy(kept["detector"]))
-    from pfctl.core.identity import TargetIdentifier
-    from pfctl.perception_setup import identity_params
+    from pfctl.app.perception import identity_params
+    from pfctl.core.perception.identity.identifier import TargetIdentifier
 
     params = dataclasses.replace(identity_params(mission), faces=False)
     perception.identifier = TargetIdentifier(kept["profile"], params)
@@ -196,11 +201,11 @@ def main() -> int:
     parser.add_argument("--save-outputs", type=Path, default=None)
     parser.add_argument("--compare-outputs", type=Path, default=None)
     parser.add_argument(
-        "--retain", action="store_true", help="pfctl.core.allocation.retain_freed_memory first"
+        "--retain", action="store_true", help="pfctl.app.memory.retain_freed_memory first"
     )
     args = parser.parse_args()
     if args.retain:
-        from pfctl.core.allocation import retain_freed_memory
+        from pfctl.app.memory import retain_freed_memory
 
         print(f"retain_freed_memory: {retain_freed_memory()}")
     if args.record is not None:

@@ -8,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from pfctl import cli
-from pfctl.core.house import HouseLayout
-from pfctl.core.planning import GridPlanner
-from pfctl.core.walls import rasterize_house
+from pfctl.core.mapping.house import HouseLayout
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import Mission, load_mission
 
 HOUSE_MISSION = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"

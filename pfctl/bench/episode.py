@@ -6,7 +6,7 @@ episode's *record*, plain JSON-able data; it never raises for a failed episode (
 --backend sim --seed SEED`` does, headless: learn the target in the simulator with the episode's
 seed (the faces depend on it), build the simulated house with that seed, for ``search`` hide the
 target (a region chosen by the seed, or one of ``scenario.randomize.hide_in``), run the mission's
-follower for the duration, and measure (:mod:`pfctl.core.episode_metrics`).
+follower for the duration, and measure (:mod:`pfctl.core.metrics`).
 
 Given the seed an episode is deterministic (the simulator is seeded, the face worker's timing is
 ``deterministic`` in the simulator, one BLAS thread): the record's ``metrics`` are the same in any
@@ -45,7 +45,7 @@ __all__ = [
 
 #: Environment variables that give numpy's BLAS / OpenMP one thread (read when it loads).
 BLAS_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-#: How the follower re-acquired a lost target (:class:`~pfctl.core.episode_metrics.Reacquisition`).
+#: How the follower re-acquired a lost target (:class:`~pfctl.core.metrics.Reacquisition`).
 HOW = ("prediction", "waypoint_search", "other")
 
 
@@ -123,8 +123,8 @@ def run_episode_task(spec: EpisodeSpec) -> dict[str, Any]:
 def _run(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[str, Any]]:
     from rich.console import Console
 
-    from pfctl.core.episode_metrics import MetricParams, follow_metrics, search_metrics
-    from pfctl.sim_episode import hide_target, run_sim_episode, sim_robot, target_profile
+    from pfctl.app.episodes import hide_target, run_sim_episode, sim_robot, target_profile
+    from pfctl.core.metrics import MetricParams, follow_metrics, search_metrics
 
     mission = spec.mission
     source = f"{spec.mission_file} [{spec.variant}]"

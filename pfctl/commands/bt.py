@@ -19,11 +19,11 @@ from typing import Annotated
 
 import typer
 
-from pfctl.bt_render import ascii_tree, btcpp_xml, dot_tree, png_tree
 from pfctl.core.behavior.registry import LEAF_SPECS, ParamSpec
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import load_mission
+from pfctl.plots.behavior_tree import ascii_tree, btcpp_xml, dot_tree, png_tree
 
 app = typer.Typer(
     help="Behavior trees: draw a mission's tree, list the leaves a tree may name.",

@@ -19,7 +19,7 @@ writes ``search.png`` and ``metrics.json``.
 house served as one by ``pfctl sim serve-hsr`` — for ``--duration`` seconds of ROS time, with a
 target profile learned before (``--target``). When the simulator's truth is on the master the
 metrics use it; on a real robot identity switches and collisions cannot be known and the
-distances are the robot's own beliefs (:mod:`pfctl.core.episode_metrics`). A robot that stops
+distances are the robot's own beliefs (:mod:`pfctl.core.metrics`). A robot that stops
 answering (stale laser or pose, lost master) has its base stopped and ends the run: the outputs of
 what was measured are written and the command exits 1 with one line saying what was lost.
 
@@ -42,21 +42,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from rich.table import Table
 
-from pfctl.commands.replay import tracks_csv
-from pfctl.core.atomic_files import atomic_write_all
-from pfctl.core.episode_metrics import (
-    FollowMetrics,
-    SearchMetrics,
-    follow_metrics,
-    search_metrics,
-)
-from pfctl.core.face_worker import FaceWorkerError
-from pfctl.core.identity import TargetProfile
-from pfctl.errors import UserError
-from pfctl.follow_session import EpisodeResult
-from pfctl.interrupts import graceful_interrupts
-from pfctl.mission import Mission, load_mission
-from pfctl.sim_episode import (
+from pfctl.app.episodes import (
     hide_target,
     metric_params,
     run_episode,
@@ -64,9 +50,23 @@ from pfctl.sim_episode import (
     sim_robot,
     target_profile,
 )
+from pfctl.app.follower import EpisodeResult
+from pfctl.commands.replay import tracks_csv
+from pfctl.core.atomic_files import atomic_write_all
+from pfctl.core.metrics import (
+    FollowMetrics,
+    SearchMetrics,
+    follow_metrics,
+    search_metrics,
+)
+from pfctl.core.perception.face_worker import FaceWorkerError
+from pfctl.core.perception.identity.identifier import TargetProfile
+from pfctl.errors import UserError
+from pfctl.interrupts import graceful_interrupts
+from pfctl.mission import Mission, load_mission
 
 if TYPE_CHECKING:
-    from pfctl.backends.pybullet.recording import EpisodeRecorder
+    from pfctl.bags.recording import EpisodeRecorder
 
 BACKENDS = ("sim", "hsr")
 
@@ -164,8 +164,8 @@ def follow(
     gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
 ) -> None:
     """Follow the mission's target; lose, predict, search, re-identify and follow again."""
-    from pfctl.follow_plots import timeline_figure, trajectory_figure
-    from pfctl.prediction_plots import png_bytes
+    from pfctl.plots.episode import timeline_figure, trajectory_figure
+    from pfctl.plots.prediction import png_bytes
 
     _check_common(backend, duration, out, target, record, gui)
     loaded = load_mission(mission)
@@ -259,7 +259,7 @@ def _recorder(record: Path | None, mission: Mission) -> EpisodeRecorder | None:
     """An episode recorder into ``record`` (as ``pfctl sim run --record``), or None."""
     if record is None:
         return None
-    from pfctl.backends.pybullet.recording import EpisodeRecorder, RecordingError
+    from pfctl.bags.recording import EpisodeRecorder, RecordingError
     from pfctl.commands.sim import _check_episode_dir
 
     _check_episode_dir(record)
@@ -340,8 +340,8 @@ def search(
     gui: Annotated[bool, typer.Option("--gui", help="Open PyBullet's window (real time).")] = False,
 ) -> None:
     """Find the mission's target somewhere in the house: belief, Algorithm 1 and frontiers."""
-    from pfctl.follow_plots import search_figure
-    from pfctl.prediction_plots import png_bytes
+    from pfctl.plots.episode import search_figure
+    from pfctl.plots.prediction import png_bytes
 
     _check_common(backend, duration, out, target, None, gui)
     if region is not None and backend == "hsr":

@@ -1,8 +1,8 @@
 """`pfctl learn-target MISSION --out target.npz`: learn what the target looks like (§II-E).
 
-The profile (:class:`pfctl.core.identity.TargetProfile`) holds the target's upper- and
-lower-body clothing histograms in the mission's ``perception.identity`` colour space and bins,
-and the 128-D embeddings of their face. Two sources:
+The profile (:class:`pfctl.core.perception.identity.identifier.TargetProfile`) holds the target's
+upper- and lower-body clothing histograms in the mission's ``perception.identity`` colour space and
+bins, and the 128-D embeddings of their face. Two sources:
 
 - ``--backend sim`` (the default): the scenario's target stands ~1.4 m in front of the simulated
   robot, facing it and turning a little from side to side; the robot turns its head to them and
@@ -43,21 +43,26 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn
 
+from pfctl.app.perception import identity_params
 from pfctl.core.atomic_files import atomic_write_all
-from pfctl.core.clothes import ClothesParams
-from pfctl.core.faces import FaceEncoder
-from pfctl.core.identity import (
+from pfctl.core.perception.clothes import ClothesParams
+from pfctl.core.perception.faces import FaceEncoder
+from pfctl.core.perception.identity.identifier import (
     Appearance,
     IdentityParams,
     TargetProfile,
     describe,
     learn_profile,
 )
+from pfctl.core.perception.vision import (
+    HogPersonDetector,
+    PersonDetection,
+    PersonDetector,
+    hog_available,
+)
 from pfctl.core.robot import STOP, HeadTarget, Pose2D, RgbdFrame, Robot, RobotLostError
-from pfctl.core.vision import HogPersonDetector, PersonDetection, PersonDetector, hog_available
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
-from pfctl.perception_setup import identity_params
 
 if TYPE_CHECKING:
     from pfctl.backends.pybullet.simulation import SimRobot
@@ -138,7 +143,7 @@ def learn_in_sim(
 ) -> Learned:
     """Frames of the target posing in front of the simulated robot (see the module docstring)."""
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-    from pfctl.core.vision import MaskPersonDetector
+    from pfctl.core.perception.vision import MaskPersonDetector
 
     learned = Learned([])
     encoder = FaceEncoder(params.face)

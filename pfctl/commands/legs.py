@@ -2,7 +2,7 @@
 
 - ``pfctl legs train [--sim-scans N] [--real DIR ...] [--seed S] [--out model.npz]``: labelled
   segments of simulated scans (and of real bags), a seeded random forest, written atomically as
-  an ``.npz`` (:mod:`pfctl.core.leg_model`).
+  an ``.npz`` (:mod:`pfctl.core.perception.legs.model`).
 - ``pfctl legs evaluate [--model M] [--real DIR] [--sim-scans N] [--seed S] [--history H]``:
   precision, recall and F1 of leg segments per data set, at 0.5–5 m and at all ranges: the
   model on held-out simulated scans (other seeds), and on the real bags cross-validated by bag
@@ -26,8 +26,17 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
-from pfctl.core.leg_model import LegModel
-from pfctl.core.leg_training import (
+from pfctl.app.leg_data import (
+    ScanSequence,
+    count_real_scans,
+    real_sequences,
+    sequences_dataset,
+    sim_dataset,
+)
+from pfctl.app.perception import leg_params
+from pfctl.core.perception.legs.detector import LegParams, load_leg_model
+from pfctl.core.perception.legs.model import LegModel
+from pfctl.core.perception.legs.training import (
     EVAL_BAND,
     LegDataset,
     Score,
@@ -36,17 +45,8 @@ from pfctl.core.leg_training import (
     evaluate_sequence,
     train_forest,
 )
-from pfctl.core.legs import LegParams, load_leg_model
 from pfctl.errors import UserError
-from pfctl.leg_data import (
-    ScanSequence,
-    count_real_scans,
-    real_sequences,
-    sequences_dataset,
-    sim_dataset,
-)
 from pfctl.mission import Mission, load_mission
-from pfctl.perception_setup import leg_params
 from pfctl.progress import progress_bar
 
 app = typer.Typer(

@@ -1,11 +1,12 @@
 """`pfctl map annotate|render|export`: regions and doors of a map — propose, write, draw, export.
 
 - ``annotate SOURCE``: take a ROS map_server map or a mission, propose rooms and doors
-  automatically (``--auto``, :mod:`pfctl.core.rooms`) and/or take them from a file or flags, write
-  them into a mission (``--out``, comments and the rest of the file kept) and draw them (``--png``).
+  automatically (``--auto``, :mod:`pfctl.core.mapping.rooms`) and/or take them from a file or flags,
+  write them into a mission (``--out``, comments and the rest of the file kept) and draw them
+  (``--png``).
 - ``render MISSION``: draw a mission's map with its regions, doors and region graph.
-- ``export MISSION``: write the house a mission's polygons imply (:mod:`pfctl.core.walls`) as a
-  ROS map_server map (YAML + PGM).
+- ``export MISSION``: write the house a mission's polygons imply
+  (:mod:`pfctl.core.mapping.walls`) as a ROS map_server map (YAML + PGM).
 
 Every bad input is a :class:`pfctl.errors.UserError` (one line, exit 2) raised before anything is
 written; every file is written atomically.
@@ -27,14 +28,14 @@ from rich.console import Console
 from rich.table import Table
 from shapely.geometry import Polygon
 
-from pfctl.core.grid import GridFileError, OccupancyGrid
-from pfctl.core.house import Door, HouseLayout, Region
-from pfctl.core.rooms import RoomParams, name_after, segment_rooms
-from pfctl.core.walls import rasterize_house
+from pfctl.core.mapping.grid import GridFileError, OccupancyGrid
+from pfctl.core.mapping.house import Door, HouseLayout, Region
+from pfctl.core.mapping.rooms import RoomParams, name_after, segment_rooms
+from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import MissionError, UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission, loads_mission
-from pfctl.mission_edit import render_regions
+from pfctl.mission.edit import render_regions
 
 app = typer.Typer(help="Maps: annotate regions and doors, render them.", no_args_is_help=True)
 
@@ -279,7 +280,7 @@ def _prepare_parent(path: Path, option: str) -> None:
 
 
 def _png_bytes(grid: OccupancyGrid, layout: HouseLayout | None, graph: bool, title: str) -> bytes:
-    from pfctl.plotting import map_figure
+    from pfctl.plots.map import map_figure
 
     fig = map_figure(grid, layout, region_graph=graph, title=title)
     buf = io.BytesIO()

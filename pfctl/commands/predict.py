@@ -29,16 +29,22 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from typer.core import TyperGroup
 
-from pfctl.core.door_experiment import CASES, run_door_experiment
-from pfctl.core.grid import GridFileError, OccupancyGrid
-from pfctl.core.house import HouseLayout
-from pfctl.core.prediction import DEFAULT_MODEL, MIN_POINTS, MODELS, PredictionError, make_model
-from pfctl.core.prediction_clip import ClippedPath, clip_prediction
-from pfctl.core.prediction_eval import ModelSpec, Score, evaluate, make_windows
-from pfctl.core.prediction_search import grid_search
-from pfctl.core.regions import RegionMap
-from pfctl.core.trajectories import Track, TrajectoryFileError, read_csv_track, read_tracks
-from pfctl.core.walls import rasterize_house
+from pfctl.core.mapping.grid import GridFileError, OccupancyGrid
+from pfctl.core.mapping.house import HouseLayout
+from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.walls import rasterize_house
+from pfctl.core.prediction.clipping import ClippedPath, clip_prediction
+from pfctl.core.prediction.door_experiment import CASES, run_door_experiment
+from pfctl.core.prediction.evaluation import ModelSpec, Score, evaluate, make_windows
+from pfctl.core.prediction.models import (
+    DEFAULT_MODEL,
+    MIN_POINTS,
+    MODELS,
+    PredictionError,
+    make_model,
+)
+from pfctl.core.prediction.search import grid_search
+from pfctl.core.prediction.tracks import Track, TrajectoryFileError, read_csv_track, read_tracks
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission
@@ -359,7 +365,7 @@ def _track_plot(
     track_file: Path,
     chosen: str,
 ) -> bytes:
-    from pfctl.prediction_plots import png_bytes, prediction_figure
+    from pfctl.plots.prediction import png_bytes, prediction_figure
 
     predictions: dict[str, np.ndarray] = {}
     for name in MODEL_NAMES:
@@ -507,7 +513,7 @@ def _grid_value(text: str) -> Any:
 def _parse_grid(model: str, specs: Sequence[str] | None) -> dict[str, list[Any]]:
     if not specs:
         return DEFAULT_GRIDS[model]
-    from pfctl.core.prediction import model_params
+    from pfctl.core.prediction.models import model_params
 
     known = model_params(model)
     grid: dict[str, list[Any]] = {}
@@ -708,7 +714,7 @@ def door(
     err = _err()
     figure: bytes | None = None
     if plot is not None:
-        from pfctl.prediction_plots import door_figure, png_bytes
+        from pfctl.plots.prediction import door_figure, png_bytes
 
         figure = png_bytes(door_figure(result, models=("svr", "svr-time", "poly3")))
     if json_out is not None:

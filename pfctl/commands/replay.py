@@ -24,22 +24,22 @@ import numpy as np
 import typer
 from rich.console import Console
 
+from pfctl.app.perception import build_perception
 from pfctl.backends.hsr.person_labels import label_detector
-from pfctl.bag_replay import Replay, open_replay
+from pfctl.bags.replay import Replay, open_replay
 from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.episode import TrackRow
-from pfctl.core.identity import TargetProfile
-from pfctl.core.perception import Perception
-from pfctl.core.robot import LaserScan, RgbdFrame
-from pfctl.core.vision import (
+from pfctl.core.perception.identity.identifier import TargetProfile
+from pfctl.core.perception.pipeline import Perception
+from pfctl.core.perception.vision import (
     GivenPersonDetector,
     HogPersonDetector,
     PersonDetector,
     hog_available,
 )
+from pfctl.core.robot import LaserScan, RgbdFrame
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
-from pfctl.perception_setup import build_perception
 from pfctl.progress import progress_bar
 
 COLUMNS = ("t", "track_id", "x", "y", "vx", "vy", "confidence", "is_target")

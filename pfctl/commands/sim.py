@@ -5,7 +5,7 @@
   optionally record the episode (``--record DIR``, a ROS 1 bag and sidecars); draw everyone's
   paths on a top-down PNG and print what happened.
 - ``export-map MISSION --out map.yaml``: the static occupancy grid the simulator's walls and
-  furniture imply (:func:`pfctl.core.walls.rasterize_house`), as a ROS map_server map.
+  furniture imply (:func:`pfctl.core.mapping.walls.rasterize_house`), as a ROS map_server map.
 - ``serve-hsr MISSION``: the house as a Toyota HSR on the ROS 1 master of ``ROS_MASTER_URI``
   (:mod:`pfctl.backends.hsr.sim_bridge`: the topics, tf, move_base and services of the mission's
   ``backend.hsr``, on a ``/clock`` of simulated time) until ``--duration`` or Ctrl-C / SIGTERM.
@@ -30,9 +30,9 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-from pfctl.core.grid import GridFileError
-from pfctl.core.planning import NoPathError
-from pfctl.core.walls import rasterize_house
+from pfctl.core.mapping.grid import GridFileError
+from pfctl.core.mapping.planning import NoPathError
+from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
@@ -86,10 +86,10 @@ def run(
     """Run the simulated house: people walk their routes; the robot stands, replays a script or
     is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
     from pfctl.backends.pybullet import drivers
-    from pfctl.backends.pybullet.episode_plot import plot_episode
-    from pfctl.backends.pybullet.recording import Episode, EpisodeRecorder, RecordingError
     from pfctl.backends.pybullet.runner import graceful_interrupts, run_episode
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
+    from pfctl.plots.sim_run import plot_episode
 
     if not (math.isfinite(duration) and duration > 0):
         raise UserError(f"--duration: expected a positive number of seconds, got {duration}")
@@ -411,7 +411,7 @@ def _serve(
     with robot:
         scene = None
         if hide is not None:
-            from pfctl.sim_episode import hide_target
+            from pfctl.app.episodes import hide_target
 
             hide_target(robot, hide)
         elif pose_target:

@@ -25,7 +25,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pfctl.core.grid import GridGeometry
+from pfctl.core.mapping.grid import GridGeometry
 from pfctl.core.robot import STOP, HeadState, HeadTarget, Pose2D, Twist2D, wrap_angle
 
 __all__ = [
@@ -389,8 +389,9 @@ class BaseController:
         The corridor is the rectangle from the robot's centre along the direction to the target,
         ``reach = d − max(following_distance − robot_radius, person_radius)`` long and
         ``2·robot_radius`` wide; it is blocked by any ``blocked`` cell whose centre lies in it, and
-        when it leaves the map (as :func:`~pfctl.core.paths.line_of_sight` would say). Only the
-        cells of the bounding boxes of 1.5 m pieces of it are looked at; no dilation of the grid.
+        when it leaves the map (as :func:`~pfctl.core.mapping.paths.line_of_sight` would say). Only
+        the cells of the bounding boxes of 1.5 m pieces of it are looked at; no dilation of the
+        grid.
         """
         if blocked is None or geometry is None:
             return True

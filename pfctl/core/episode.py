@@ -4,7 +4,7 @@ The follower (:mod:`pfctl.core.follower`) appends a :class:`TickRecord` per beha
 what the robot believed (its pose, the target's track, its awareness, the active action, the
 navigation goal). A backend that knows the truth (the simulator) appends the
 :class:`~pfctl.core.robot.GroundTruth` of the same instant to :attr:`EpisodeLog.truths`; metrics
-(:mod:`pfctl.core.episode_metrics`) compare the two, the follower's decisions never read truth.
+(:mod:`pfctl.core.metrics`) compare the two, the follower's decisions never read truth.
 """
 
 from __future__ import annotations
@@ -90,7 +90,8 @@ class EpisodeLog:
     tracks: list[TrackRow] = field(default_factory=list)
     """After each laser scan a tick fed to the perception (before its camera frame), one row per
     confirmed track seen then (coasting ones are left out), stamped with the scan: what
-    ``pfctl replay`` writes after each scan of a bag (:func:`pfctl.core.perception.track_rows`)."""
+    ``pfctl replay`` writes after each scan of a bag
+    (:func:`pfctl.core.perception.pipeline.track_rows`)."""
 
 
 __all__ = [

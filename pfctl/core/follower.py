@@ -4,7 +4,7 @@
 
 1. **observe** — the newest laser scan, RGB-D frame, pose and head angles (Robot port);
 2. **perceive** — legs + vision → tracking → identification (Algorithm 2) and the human belief
-   (Eq. 4): :class:`~pfctl.core.perception.Perception`;
+   (Eq. 4): :class:`~pfctl.core.perception.pipeline.Perception`;
 3. **map** — the scan is fused into the robot's occupancy grid (Eq. 1), which starts unknown, so
    what the robot has not seen yet shows as frontiers for Algorithm 1;
 4. **target state** — the identified track (if the tracker still has it), the last detection and
@@ -45,14 +45,14 @@ from pfctl.core.behavior.skills import SearchParams, Skills
 from pfctl.core.behavior.tree import build_tree
 from pfctl.core.control import KNOWN_RADIUS, ControlParams, unknown_peak
 from pfctl.core.episode import EpisodeLog, PredictionRecord, TickRecord, WaypointRecord
-from pfctl.core.grid import InverseSensorModel, OccupancyGrid
-from pfctl.core.identity import Decision
-from pfctl.core.paths import line_of_sight
-from pfctl.core.perception import Perception
-from pfctl.core.planning import GridPlanner
-from pfctl.core.prediction import MIN_POINTS, PredictionError, make_model
-from pfctl.core.prediction_clip import clip_prediction
-from pfctl.core.regions import RegionMap
+from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
+from pfctl.core.mapping.paths import line_of_sight
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.perception.identity.identifier import Decision
+from pfctl.core.perception.pipeline import Perception
+from pfctl.core.prediction.clipping import clip_prediction
+from pfctl.core.prediction.models import MIN_POINTS, PredictionError, make_model
 from pfctl.core.robot import STOP, Observation, Robot
 
 #: Belief peaks considered for the gaze (the best one away from known people wins).

@@ -158,12 +158,13 @@ class CameraInfo:
 class GivenPerson:
     """A person an external detector found in a frame's colour image, in 2-D only (§II-E: the
     paper's OpenPose ran beside the robot; the follower places its people in 3-D with the
-    depth, :class:`pfctl.core.vision.GivenPersonDetector`)."""
+    depth, :class:`pfctl.core.perception.vision.GivenPersonDetector`)."""
 
     box: tuple[int, int, int, int]
     """Image box ``(x0, y0, x1, y1)`` of the whole body, pixels (``x1``, ``y1`` exclusive)."""
     keypoints: Mapping[str, tuple[float, float]] | None = None
-    """2-D keypoints ``name -> (u, v)`` (:data:`pfctl.core.vision.Keypoints`), when known."""
+    """2-D keypoints ``name -> (u, v)`` (:data:`pfctl.core.perception.vision.Keypoints`), when
+    known."""
     score: float = 1.0
     """The detector's confidence (OpenPose: the mean confidence of the keypoints)."""
     head_box: tuple[int, int, int, int] | None = None

@@ -6,8 +6,8 @@ the core port and the ROS REPs:
 * LaserScan (REP-117): core keeps ``inf`` for every range that is not a valid return, because
   :meth:`pfctl.core.robot.LaserScan.points` uses only finite values. So NaN (invalid), ``-inf``
   (too close), ``+inf`` (no return) and finite values outside ``[range_min, range_max]`` all
-  become ``inf`` on the way in (as :func:`pfctl.bags.laser_scan` does for ROS 2 bags); on the way
-  out ``inf`` is sent as ``+inf`` ("no return"), which REP-117 consumers understand.
+  become ``inf`` on the way in (as :func:`pfctl.bags.reading.laser_scan` does for ROS 2 bags); on
+  the way out ``inf`` is sent as ``+inf`` ("no return"), which REP-117 consumers understand.
 * Depth (REP-118): core depth is ``float32`` metres with ``inf`` where nothing is seen.
   ``16UC1`` is millimetres with 0 = no return; ``32FC1`` is metres with NaN (or non-positive /
   infinite) = no return. Colour is always ``(h, w, 3) uint8`` RGB in core.

@@ -29,9 +29,10 @@ index in ``person``, ``i`` in ``part``, the image's header.
 points, a part outside 0–26, a person index that is not a whole number ≥ 0, a non-finite value,
 a part given twice: :class:`ValueError` saying what was expected) and returns each person's
 parts; :func:`given_person` turns them into the :class:`~pfctl.core.robot.GivenPerson` core
-places in 3-D (:class:`~pfctl.core.vision.GivenPersonDetector`); :func:`people_from_cloud` does
-both. ``pfctl sim serve-hsr`` stands in for OpenPose with the simulator's mask detections
-(:func:`detection_parts`); :func:`cloud_fields` gives the points and channels of a message.
+places in 3-D (:class:`~pfctl.core.perception.vision.GivenPersonDetector`);
+:func:`people_from_cloud` does both. ``pfctl sim serve-hsr`` stands in for OpenPose with the
+simulator's mask detections (:func:`detection_parts`); :func:`cloud_fields` gives the points and
+channels of a message.
 """
 
 from __future__ import annotations
@@ -42,8 +43,8 @@ from typing import Any
 
 import numpy as np
 
+from pfctl.core.perception.vision import PersonDetection
 from pfctl.core.robot import GivenPerson
-from pfctl.core.vision import PersonDetection
 
 BODY_25 = (
     "nose",
@@ -195,7 +196,7 @@ def given_person(parts: Parts, shape: tuple[int, int]) -> GivenPerson | None:
     - ``keypoints``: ``head`` (the mean of nose, eyes and ears), ``neck`` (1), ``mid_hip`` (8,
       else the mid-point of the hips 9 and 12), ``ankles`` (the mid-point of 11 and 14, or
       whichever was found), and the shoulders (2, 5) and hips (9, 12) that were found, whose
-      depth places the person (:class:`~pfctl.core.vision.GivenPersonDetector`);
+      depth places the person (:class:`~pfctl.core.perception.vision.GivenPersonDetector`);
     - ``head_box``: around the head keypoints (see :func:`_head`), clipped, when there are some;
     - ``score``: the mean confidence of the points found (corners included).
 

@@ -9,7 +9,8 @@ writes part 0; one that knows heads lets Algorithm 2 search faces there.
 
 ``pfctl sim serve-hsr`` makes this image from the simulator's segmentation mask
 (:func:`encode_labels`); the backend and ``pfctl replay`` read it with :func:`label_detector`,
-the same :class:`~pfctl.core.vision.MaskPersonDetector` the simulated follower uses on the mask.
+the same :class:`~pfctl.core.perception.vision.MaskPersonDetector` the simulated follower uses on
+the mask.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from pfctl.core.vision import MaskPersonDetector
+from pfctl.core.perception.vision import MaskPersonDetector
 
 PARTS = ("", "head", "torso", "leg")
 """Part names by code ``(v - 1) % 4``; ``""`` is a body pixel of no known part."""

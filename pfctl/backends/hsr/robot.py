@@ -55,7 +55,8 @@ from pfctl.backends.hsr.master import MASTER_ERRORS, master_proxy
 from pfctl.backends.hsr.person_keypoints import people_from_cloud
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
-from pfctl.bag_replay import image_labels
+from pfctl.bags.replay import image_labels
+from pfctl.core.perception.vision import GivenPersonDetector, MaskPersonDetector
 from pfctl.core.robot import (
     STOP,
     GivenPerson,
@@ -72,7 +73,6 @@ from pfctl.core.robot import (
     Twist2D,
 )
 from pfctl.core.tf_buffer import quaternion_matrix
-from pfctl.core.vision import GivenPersonDetector, MaskPersonDetector
 from pfctl.errors import UserError
 from pfctl.mission import HsrConfig, Mission
 
@@ -120,12 +120,12 @@ def check_master(uri: str, timeout: float = 2.0) -> None:
 
 def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
     """The people of a ``visualization_msgs/MarkerArray`` in the simulator's truth encoding
-    (:func:`pfctl.backends.pybullet.recording.person_marker`: ``ns`` = name, pose = position and
+    (:func:`pfctl.bags.recording.person_marker`: ``ns`` = name, pose = position and
     heading, ``text`` = ``"target speed=0.800"``); markers that are not ADD are skipped.
 
     The decoder is the simulator's (imported here, not at module level: a real robot publishes
     no truth and its process never loads the PyBullet backend)."""
-    from pfctl.backends.pybullet.recording import person_from_marker
+    from pfctl.bags.recording import person_from_marker
 
     return tuple(
         person_from_marker(m.ns, convert.pose2d_from_pose(m.pose), m.text)

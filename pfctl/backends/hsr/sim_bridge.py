@@ -39,7 +39,7 @@ What is published when
     6. once per control period (and at ``t`` = 0): the truth for metrics, never for the follower:
        ``<ground_truth>/robot`` (``geometry_msgs/PoseStamped``, the true pose),
        ``<ground_truth>/people`` (``visualization_msgs/MarkerArray``, one CYLINDER per person as
-       :func:`pfctl.backends.pybullet.recording.person_marker` encodes it) and
+       :func:`pfctl.bags.recording.person_marker` encodes it) and
        ``<ground_truth>/collisions`` (``std_msgs/UInt32``).
 
     ``/tf_static`` (latched) holds ``base_footprint → base_range_sensor_link`` (the laser mount of
@@ -94,12 +94,13 @@ from pfctl.backends.hsr.person_keypoints import cloud_message, detection_parts
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
-from pfctl.backends.pybullet.recording import (
+from pfctl.bags.recording import (
     CAMERA_FRAME,
     LASER_FRAME,
     camera_in_base,
     person_marker,
 )
+from pfctl.core.perception.vision import MaskPersonDetector, PersonDetection
 from pfctl.core.robot import (
     STOP,
     GroundTruth,
@@ -109,7 +110,6 @@ from pfctl.core.robot import (
     RgbdFrame,
     Twist2D,
 )
-from pfctl.core.vision import MaskPersonDetector, PersonDetection
 from pfctl.errors import UserError
 from pfctl.mission import Mission
 

@@ -15,7 +15,7 @@ People's legs are :class:`~pfctl.backends.pybullet.walkers.Walker` legs (``Walke
 wide trousers; the 2-D laser has no height, so the different mount heights of the lasers show
 only as these different leg widths). The labels are the true leg circles ``[x, y, radius]`` in
 the map frame: a segment is a leg when most of its returns lie on one
-(:func:`pfctl.core.leg_training.label_by_circles`).
+(:func:`pfctl.core.perception.legs.training.label_by_circles`).
 
 Everything is seeded: the same seed gives the same scans.
 """

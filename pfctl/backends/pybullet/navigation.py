@@ -1,6 +1,6 @@
 """A MOVE_BASE equivalent for an omnidirectional base: plan on the static map, follow, re-plan.
 
-:class:`Navigator` plans with a :class:`~pfctl.core.planning.GridPlanner` (the static map
+:class:`Navigator` plans with a :class:`~pfctl.core.mapping.planning.GridPlanner` (the static map
 inflated by the robot's radius) — at once (:meth:`Navigator.start`), or, like move_base, in its
 own control loop after the goal was accepted (:meth:`Navigator.accept`, then the next
 :meth:`Navigator.update`) — and follows the path with a pure-pursuit controller for a
@@ -22,7 +22,7 @@ import math
 import numpy as np
 from scipy import optimize
 
-from pfctl.core.planning import GridPlanner, NoPathError
+from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
 
 #: Pure-pursuit carrot distance along the path, metres.

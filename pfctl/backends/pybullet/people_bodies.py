@@ -9,9 +9,9 @@ scikit-image's subset of Labeled Faces in the Wild (``skimage.data.lfw_subset()`
 crops; Huang et al. 2007): each person wears a distinct one of :data:`LFW_FACES`, in a seeded
 order, tinted with a seeded skin tone (:func:`face_texture`). Measured on renders of three people
 at 1.2-2.5 m, facing the camera or turned by up to 20°, three seeds (faces searched in the
-head's mask region scaled to 100 px wide, :class:`pfctl.core.faces.FaceEncoder`): at 640x480
-every face was found (63/63), the same person's embeddings stayed within 0.45 of each other and
-different people were at least 0.65 apart; at the house's 320x240, 62/63 were found, the same
+head's mask region scaled to 100 px wide, :class:`pfctl.core.perception.faces.FaceEncoder`): at
+640x480 every face was found (63/63), the same person's embeddings stayed within 0.45 of each other
+and different people were at least 0.65 apart; at the house's 320x240, 62/63 were found, the same
 person within 0.54, different people at least 0.55 apart (so a single frame can mislead; the
 identifier decides on the median over a track's faces). Static bodies never touch each other, so
 people do not collide among themselves; they are solid for the robot, the laser

@@ -16,8 +16,8 @@ from dataclasses import dataclass, field
 from typing import Protocol
 
 from pfctl.backends.pybullet.drivers import KeyboardDriver, ScriptStep
-from pfctl.backends.pybullet.recording import EpisodeRecorder
 from pfctl.backends.pybullet.simulation import SimRobot
+from pfctl.bags.recording import EpisodeRecorder
 from pfctl.core.robot import STOP, GroundTruth
 from pfctl.interrupts import StopFlag, graceful_interrupts
 

@@ -49,7 +49,8 @@ from pfctl.backends.pybullet.people_bodies import PeopleBodies
 from pfctl.backends.pybullet.robot_body import RobotBody
 from pfctl.backends.pybullet.walkers import Walker, make_walkers
 from pfctl.backends.pybullet.world import build_world
-from pfctl.core.planning import GridPlanner
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.walls import house_bounds, rasterize_house
 from pfctl.core.robot import (
     STOP,
     GroundTruth,
@@ -62,7 +63,6 @@ from pfctl.core.robot import (
     Twist2D,
     wrap_angle,
 )
-from pfctl.core.walls import house_bounds, rasterize_house
 from pfctl.mission import Mission
 
 #: Radius of a person's body for contacts with the robot, metres (the torso's half width).

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from pfctl.core.planning import GridPlanner, NoPathError
+from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import PersonTruth
 from pfctl.mission import Mission, Person
 

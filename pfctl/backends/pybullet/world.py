@@ -2,7 +2,8 @@
 
 - Each region's floor is a flat mesh of its polygon (rooms get slightly different tints), over an
   invisible ground plane that carries the collisions.
-- Walls are the boxes of :func:`pfctl.core.walls.wall_boxes` extruded to ``map.wall_height``,
+- Walls are the boxes of :func:`pfctl.core.mapping.walls.wall_boxes` extruded to
+``map.wall_height``,
   with gaps at the doors.
 - Furniture (``map.obstacles``) is its polygon extruded to its height, as a visual mesh and a
   static triangle-mesh collision shape, so concave pieces are exact.
@@ -20,7 +21,7 @@ import pybullet as p
 import shapely
 from shapely.geometry.polygon import orient
 
-from pfctl.core.walls import wall_boxes
+from pfctl.core.mapping.walls import wall_boxes
 from pfctl.mission import Mission
 
 WALL_RGBA = (0.86, 0.85, 0.80, 1.0)

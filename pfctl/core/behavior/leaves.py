@@ -27,7 +27,7 @@ from pfctl.core.behavior.blackboard import PredictionState, Sighting, TargetStat
 from pfctl.core.behavior.registry import LEAF_SPECS
 from pfctl.core.behavior.skills import Skills
 from pfctl.core.control import sweep_pan
-from pfctl.core.regions import WaypointDecision
+from pfctl.core.mapping.regions import WaypointDecision
 
 
 class Leaf(py_trees.behaviour.Behaviour):

@@ -29,9 +29,9 @@ from pfctl.core.control import (
     choose_gaze,
     gaze_angles,
 )
-from pfctl.core.grid import OCCUPIED_THRESH, OccupancyGrid, logit
-from pfctl.core.planning import GridPlanner
-from pfctl.core.regions import RegionMap, WaypointChoice, WaypointDecision, waypoint_search
+from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.regions import RegionMap, WaypointChoice, WaypointDecision, waypoint_search
 from pfctl.core.robot import STOP, HeadState, HeadTarget, NavStatus, Pose2D, Robot, Twist2D
 
 #: A new MOVE_BASE goal is sent only when it moved farther than this from the one being driven to.
@@ -53,7 +53,7 @@ class SearchParams:
     heading_window_s: float = 3.0
     waypoint_choice: WaypointChoice = "utility"
     """``utility`` (Eq. 3, the paper) or ``nearest`` (the nearest reachable frontier, a
-    baseline; :func:`~pfctl.core.regions.waypoint_search`)."""
+    baseline; :func:`~pfctl.core.mapping.regions.waypoint_search`)."""
 
 
 class Skills:

@@ -1,0 +1,179 @@
+"""A mission's follower: core parameters from its YAML sections, and an episode loop.
+
+``core`` never reads the mission; this module turns ``control``, ``search``, ``prediction``,
+``robot`` and ``behavior`` into the follower's values (:func:`follower_params`), builds the
+:class:`~pfctl.core.follower.Follower` for a robot (:func:`build_follower`) and runs it
+(:func:`run_follower`): each control period one follower tick, then one robot step. The base is
+stopped at the end whatever happens.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from pfctl.app.memory import retain_freed_memory
+from pfctl.core.behavior.skills import SearchParams
+from pfctl.core.control import ControlParams
+from pfctl.core.episode import EpisodeLog, TickRecord
+from pfctl.core.follower import Follower, FollowerParams, PredictionParams
+from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
+from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.walls import rasterize_house
+from pfctl.core.perception.pipeline import Perception
+from pfctl.core.robot import STOP, GroundTruth, Robot, RobotLostError
+from pfctl.mission import Mission
+
+
+def control_params(mission: Mission) -> ControlParams:
+    """Gaze and base control (``control``, ``robot``, ``sensors.camera``)."""
+    c, r = mission.control, mission.robot
+    return ControlParams(
+        following_distance=c.following_distance,
+        min_distance=c.min_distance,
+        turn_threshold=c.turn_threshold,
+        max_linear_speed=r.max_linear_speed,
+        max_angular_speed=r.max_angular_speed,
+        robot_radius=r.radius,
+        stale_after=c.stale_after,
+        pan_limits=(r.head_pan_limits[0], r.head_pan_limits[1]),
+        tilt_limits=(r.head_tilt_limits[0], r.head_tilt_limits[1]),
+        head_max_speed=r.head_max_speed,
+        camera_height=mission.sensors.camera.mount_height,
+    )
+
+
+def follower_params(mission: Mission) -> FollowerParams:
+    """The follower's parameters from the mission."""
+    s, p = mission.search, mission.prediction
+    return FollowerParams(
+        tick_hz=mission.behavior.tick_hz,
+        control=control_params(mission),
+        search=SearchParams(
+            alpha=s.alpha,
+            beta=s.beta,
+            frontier_threshold=s.frontier_threshold,
+            min_frontier_cells=s.min_frontier_cells,
+            heading_window_s=s.heading_window_s,
+            waypoint_choice=s.waypoint_choice,
+        ),
+        prediction=PredictionParams(
+            model=p.model,
+            params={
+                "C": p.svr.C,
+                "epsilon": p.svr.epsilon,
+                "gamma": p.svr.gamma,
+                "weighting": p.weighting.kind,
+                "half_life_s": p.weighting.half_life_s,
+            },
+            history_s=p.history_s,
+            horizon_s=p.horizon_s,
+        ),
+    )
+
+
+def static_map(mission: Mission) -> OccupancyGrid:
+    """The house's walls and furniture as the robot's navigation map."""
+    if mission.map.occupancy is not None:
+        return OccupancyGrid.load_map_server(mission.map.occupancy)
+    return rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
+
+
+def build_follower(
+    mission: Mission, robot: Robot, perception: Perception, log: EpisodeLog | None = None
+) -> Follower:
+    """The mission's follower on ``robot`` with ``perception``."""
+    sm = mission.map.sensor_model
+    grid = static_map(mission)
+    regions = RegionMap(mission.layout())
+    # cached per geometry (~10 ms): made here, not in the tick of the first prediction or
+    # Algorithm 1 (both block the region map's walls on this map's grid)
+    regions.blocked_mask(grid.geometry)
+    return Follower(
+        robot,
+        perception,
+        mission.behavior.tree.model_dump(exclude_none=True),
+        follower_params(mission),
+        static_map=grid,
+        regions=regions,
+        sensor_model=InverseSensorModel(sm.p_hit, sm.p_miss, sm.p_min, sm.p_max),
+        robot_radius=mission.robot.radius,
+        log=log,
+    )
+
+
+@dataclass
+class EpisodeResult:
+    """How a run ended."""
+
+    log: EpisodeLog
+    sim_time: float = 0.0
+    wall_time: float = 0.0
+    interrupted: bool = False
+    stopped_early: bool = False
+    """``until`` ended the run before ``duration``."""
+    tick_seconds: list[float] = field(default_factory=list)
+    """Wall time of each follower tick (not the robot's step), seconds."""
+    clock_origin: float = 0.0
+    """The robot's clock at the episode's t = 0 (ROS time on the HSR; 0 in the simulator)."""
+    lost: str | None = None
+    """Why the run ended early because the robot stopped answering (:class:`RobotLostError`)."""
+
+
+def run_follower(
+    follower: Follower,
+    robot: Robot,
+    duration: float,
+    *,
+    now: Callable[[], float],
+    truth: Callable[[], GroundTruth] | None = None,
+    on_tick: Callable[[float], None] | None = None,
+    stop: Callable[[], bool] | None = None,
+    until: Callable[[TickRecord], bool] | None = None,
+) -> EpisodeResult:
+    """Tick ``follower`` and step ``robot`` until ``now()`` reaches ``duration`` (or ``until``
+    says so after a tick, or ``stop`` asks to end). ``truth`` (simulator) is recorded beside each
+    tick for the metrics. A robot that stops answering (:class:`RobotLostError`) ends the run
+    with :attr:`EpisodeResult.lost` set, keeping what was measured. The follower is closed (base
+    stopped) at the end."""
+    import time
+
+    retain_freed_memory()  # the next tick reuses this tick's pages (no page faults per tick)
+    result = EpisodeResult(follower.log)
+    start = time.perf_counter()
+    try:
+        while now() < duration - 1e-9:
+            if stop is not None and stop():
+                result.interrupted = True
+                break
+            t0 = time.perf_counter()
+            record = follower.tick()
+            result.tick_seconds.append(time.perf_counter() - t0)
+            if truth is not None:
+                follower.log.truths.append(truth())
+            if until is not None and until(record):
+                result.stopped_early = True
+                break
+            robot.step()
+            if on_tick is not None:
+                on_tick(now())
+    except KeyboardInterrupt:
+        result.interrupted = True
+    except RobotLostError as err:
+        result.lost = str(err)
+    finally:
+        follower.close()
+        robot.command(STOP)
+    result.sim_time = now()
+    result.wall_time = time.perf_counter() - start
+    return result
+
+
+__all__ = [
+    "EpisodeResult",
+    "build_follower",
+    "control_params",
+    "follower_params",
+    "run_follower",
+    "static_map",
+]

@@ -1,0 +1,274 @@
+"""Frontiers of the occupancy grid (Eq. 2, §II-C) and their utility (Eq. 3, §II-D).
+
+A frontier is the border between known-free and unknown space: going there reveals the unknown.
+The paper finds frontier cells with the frontier map of **Eq. 2**,
+
+    F = ‖∇Λ‖₁ − β (‖∇Λ_o‖₁ + Λ_o − 0.5),
+
+clusters them, and scores each cluster ``c`` for a robot at ``x`` heading to region ``l*`` with
+the utility of **Eq. 3**, ``U(c, x, l*) = α·N − (d(x, c) + d(c, l*))``, with ``N`` the number of
+unknown cells the cluster borders. Precisely, here:
+
+* **Λ** is the trinary map built from the grid's states (``grid.states()``): occupied 1, free 0,
+  unknown 0.5 — so sensor noise inside free space (p = 0.1 vs 0.15) never shows as a gradient.
+* **Λ_o** is the obstacle map: 1 on occupied cells, 0.5 elsewhere; so ``Λ_o − 0.5`` is 0.5 on
+  obstacles and 0 elsewhere.
+* **‖∇X‖₁** at a cell is the L1 norm of its eight neighbour differences (the forward and backward
+  differences along x, y and both diagonals): ``Σ_{n ∈ N8(c)} |X(n) − X(c)|``, with the map edge
+  replicated (no gradient across the border of the map). Any cell with a differently valued
+  8-neighbour lights up, on both sides of a border: a free cell with ``k_u`` unknown and ``k_o``
+  occupied neighbours has ``F = 0.5·k_u + (1 − β/2)·k_o``; an unknown cell next to an obstacle
+  has ``‖∇Λ‖₁`` contributions of 0.5 per obstacle neighbour, cancelled at β ≥ 1; obstacle cells
+  get the extra −β/2. At β = 2 every border touching an obstacle cancels (free cells keep
+  ``0.5·k_u``, obstacle cells go negative); the shipped mission's β = 1 leaves the free side of
+  walls at ``0.5·k_o``.
+
+Eq. 2 alone thus lights up both sides of every border, and with β < 2 also the free side of
+walls. The frontier cells of :func:`find_frontiers` are therefore, exactly:
+
+    F > threshold  ∧  the cell is known free  ∧  an 8-neighbour is unknown  ∧  no 8-neighbour is
+    occupied,
+
+i.e. the known-free side of the free/unknown border, minus the cells that touch a wall (those
+would send the robot into the wall's corner, and a wall seen edge-on is not a way into unknown
+space). For ``0 ≤ threshold < 0.5`` the F test is implied by the others (F ≥ 0.5 there), so the
+frontier cells are exactly "free, 8-adjacent to unknown, not 8-adjacent to occupied". Clusters are
+the 8-connected components of frontier cells (``scipy.ndimage.label``); smaller than
+``min_cells`` are dropped.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import ndimage
+
+from pfctl.core.mapping.grid import (
+    FREE,
+    FREE_THRESH,
+    OCCUPIED,
+    OCCUPIED_THRESH,
+    UNKNOWN,
+    GridGeometry,
+)
+
+if TYPE_CHECKING:
+    from pfctl.core.mapping.grid import OccupancyGrid
+
+__all__ = [
+    "FrontierCluster",
+    "closest_point",
+    "find_frontiers",
+    "frontier_map",
+    "frontiers_from_states",
+    "gradient_l1",
+    "trinary_map",
+    "utility",
+]
+
+_EIGHT = np.ones((3, 3), dtype=bool)
+_OFFSETS = ((-1, -1), (-1, 0), (-1, 1), (0, -1), (0, 1), (1, -1), (1, 0), (1, 1))
+
+#: d(·) of Eq. 3 as a function of points: (k, 2) → (k,) metres.
+DistanceFn = Callable[[NDArray[np.float64]], NDArray[np.float64]]
+
+
+def gradient_l1(x: ArrayLike) -> NDArray[np.float64]:
+    """‖∇X‖₁ of Eq. 2: ``Σ_{n ∈ N8(c)} |X(n) − X(c)|`` per cell, map edge replicated."""
+    x = np.asarray(x, dtype=np.float64)
+    p = np.pad(x, 1, mode="edge")
+    h, w = x.shape
+    out = np.zeros_like(x)
+    for dr, dc in _OFFSETS:
+        out += np.abs(p[1 + dr : 1 + dr + h, 1 + dc : 1 + dc + w] - x)
+    return out
+
+
+def trinary_map(states: ArrayLike) -> NDArray[np.float64]:
+    """Λ of Eq. 2 from FREE/OCCUPIED/UNKNOWN states: O = 1, F = 0, U = 0.5."""
+    s = np.asarray(states)
+    lam = np.full(s.shape, 0.5)
+    lam[s == FREE] = 0.0
+    lam[s == OCCUPIED] = 1.0
+    return lam
+
+
+def frontier_map(
+    grid_prob: ArrayLike, obstacle_mask: ArrayLike, beta: float
+) -> NDArray[np.float64]:
+    """The frontier map of **Eq. 2**: F = ‖∇Λ‖₁ − β (‖∇Λ_o‖₁ + Λ_o − 0.5).
+
+    ``grid_prob`` is Λ, the map as probabilities — meant to be the trinary map (occupied 1,
+    free 0, unknown 0.5; see :func:`trinary_map`) so that noise in free space shows no gradient.
+    ``obstacle_mask`` (bool, same shape) marks the obstacles; Λ_o is 1 there and 0.5 elsewhere.
+    ‖∇·‖₁ is :func:`gradient_l1` (the eight neighbour differences). See the module docstring for
+    what the terms do at each kind of border.
+    """
+    lam = np.asarray(grid_prob, dtype=np.float64)
+    obstacles = np.asarray(obstacle_mask, dtype=bool)
+    if lam.shape != obstacles.shape:
+        raise ValueError(f"Λ has shape {lam.shape} but the obstacle mask {obstacles.shape}")
+    lam_o = np.where(obstacles, 1.0, 0.5)
+    return gradient_l1(lam) - beta * (gradient_l1(lam_o) + lam_o - 0.5)
+
+
+@dataclass(frozen=True, eq=False)
+class FrontierCluster:
+    """One cluster of frontier cells (§II-C).
+
+    ``cells`` are ``(row, col)`` grid indices (k, 2); ``points`` their centres in the map frame
+    (k, 2); ``centroid`` the mean of ``points``; ``n_unknown`` is N of Eq. 3: the number of
+    distinct unknown cells in the 8-neighbourhoods of the cluster's cells.
+    """
+
+    cells: NDArray[np.intp] = field(repr=False)
+    points: NDArray[np.float64] = field(repr=False)
+    centroid: tuple[float, float]
+    n_unknown: int
+
+    @property
+    def size(self) -> int:
+        """Number of frontier cells."""
+        return len(self.cells)
+
+
+def find_frontiers(
+    grid: OccupancyGrid,
+    beta: float,
+    threshold: float,
+    min_cells: int,
+    free_thresh: float = FREE_THRESH,
+    occupied_thresh: float = OCCUPIED_THRESH,
+) -> list[FrontierCluster]:
+    """Frontier clusters of an occupancy grid (Eq. 2, §II-C), largest first.
+
+    Frontier cells are ``F > threshold ∧ free ∧ 8-adjacent to unknown ∧ not 8-adjacent to
+    occupied`` (module docstring), with the states of ``grid.states(free_thresh,
+    occupied_thresh)``; clusters are their 8-connected components of at least ``min_cells`` cells.
+    Ties in size are broken by the first cell in row-major order, so the order is deterministic.
+    """
+    states = grid.states(free_thresh, occupied_thresh)
+    return frontiers_from_states(states, grid.geometry, beta, threshold, min_cells)
+
+
+def _dilate8(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
+    """Binary dilation by the 3 × 3 square (separable: rows, then columns)."""
+    rows = mask.copy()
+    rows[:, 1:] |= mask[:, :-1]
+    rows[:, :-1] |= mask[:, 1:]
+    out = rows.copy()
+    out[1:, :] |= rows[:-1, :]
+    out[:-1, :] |= rows[1:, :]
+    return out
+
+
+def frontiers_from_states(
+    states: ArrayLike,
+    geometry: GridGeometry,
+    beta: float,
+    threshold: float,
+    min_cells: int,
+) -> list[FrontierCluster]:
+    """:func:`find_frontiers` on a FREE/OCCUPIED/UNKNOWN state array with its geometry.
+
+    For speed, Eq. 2 is evaluated only at the cells the other three conditions leave (free, an
+    unknown and no occupied 8-neighbour) — the same values :func:`frontier_map` gives there.
+    """
+    s = np.asarray(states, dtype=np.int8)
+    h, w = s.shape
+    unknown = s == UNKNOWN
+    occupied = s == OCCUPIED
+    candidate = (s == FREE) & _dilate8(unknown) & ~_dilate8(occupied)
+    rr, cc = np.nonzero(candidate)
+    if rr.size:
+        # Eq. 2 at the candidates: gather the 3×3 neighbourhood of states (edge replicated).
+        padded = np.pad(s, 1, mode="edge")
+        neigh = np.stack([padded[rr + 1 + dr, cc + 1 + dc] for dr, dc in _OFFSETS], axis=1)
+        lam_lut = np.array([0.0, 1.0, 0.5])  # index by state: FREE 0, OCCUPIED 1, UNKNOWN -1
+        lamo_lut = np.array([0.5, 1.0, 0.5])
+        centre = s[rr, cc]
+        grad = np.abs(lam_lut[neigh] - lam_lut[centre][:, None]).sum(axis=1)
+        grad_o = np.abs(lamo_lut[neigh] - lamo_lut[centre][:, None]).sum(axis=1)
+        F = grad - beta * (grad_o + lamo_lut[centre] - 0.5)
+        keep = threshold < F
+        rr, cc = rr[keep], cc[keep]
+    frontier = np.zeros((h, w), dtype=bool)
+    frontier[rr, cc] = True
+    labels, n = ndimage.label(frontier, structure=_EIGHT)
+    if n == 0:
+        return []
+    lab = labels[rr, cc]  # rr, cc are in row-major order
+    sizes = np.bincount(lab, minlength=n + 1)
+    # N: distinct unknown cells in the 8-neighbourhood of each cluster.
+    upad = np.pad(unknown, 1)
+    pairs = []
+    for dr, dc in _OFFSETS:
+        r2, c2 = rr + dr, cc + dc
+        hit = upad[r2 + 1, c2 + 1]
+        pairs.append(lab[hit].astype(np.int64) * (h * w) + (r2[hit] * w + c2[hit]))
+    unique_pairs = np.unique(np.concatenate(pairs))
+    n_unknown = np.bincount(unique_pairs // (h * w), minlength=n + 1)
+    order = np.argsort(lab, kind="stable")
+    starts = np.searchsorted(lab[order], np.arange(1, n + 2))
+    points_all = geometry.cell_to_world(rr, cc)
+    clusters: list[tuple[int, int, FrontierCluster]] = []
+    for i in range(1, n + 1):
+        if sizes[i] < min_cells:
+            continue
+        sel = order[starts[i - 1] : starts[i]]
+        cells = np.stack([rr[sel], cc[sel]], axis=1).astype(np.intp)
+        points = points_all[sel]
+        centroid = points.mean(axis=0)
+        cluster = FrontierCluster(
+            cells, points, (float(centroid[0]), float(centroid[1])), int(n_unknown[i])
+        )
+        clusters.append((-int(sizes[i]), int(cells[0, 0]) * w + int(cells[0, 1]), cluster))
+    clusters.sort(key=lambda t: (t[0], t[1]))
+    return [c for _, _, c in clusters]
+
+
+def closest_point(cluster: FrontierCluster, target: ArrayLike) -> NDArray[np.float64]:
+    """The point of ``cluster`` closest (Euclidean) to ``target``: the goal c of Algorithm 1."""
+    t = np.asarray(target, dtype=float)
+    i = int(np.argmin(np.sum((cluster.points - t) ** 2, axis=1)))
+    return cluster.points[i].copy()
+
+
+def utility(
+    cluster: FrontierCluster,
+    x: ArrayLike,
+    l_star: ArrayLike | None,
+    alpha: float,
+    distance_from_robot: DistanceFn | None = None,
+    distance_to_l_star: DistanceFn | None = None,
+) -> float:
+    """The utility of **Eq. 3**: U(c, x, l*) = α·N − (d(x, c) + d(c, l*)).
+
+    ``c`` is the cluster's point closest to ``l_star`` (Algorithm 1; :func:`closest_point`),
+    N = ``cluster.n_unknown``. ``distance_from_robot(points)`` is d(x, ·) and
+    ``distance_to_l_star(points)`` is d(·, l*), vectorised over ``(k, 2)`` points (e.g. a
+    :class:`pfctl.core.mapping.paths.DistanceField` from x and from l*); Euclidean when omitted.
+    With ``l_star`` None there is no heading region: c is the point closest to x and the d(c, l*)
+    term is dropped (pure exploration).
+    """
+    xa = np.asarray(x, dtype=float)
+    if l_star is None:
+        c = closest_point(cluster, xa)
+        d_cl = 0.0
+    else:
+        la = np.asarray(l_star, dtype=float)
+        c = closest_point(cluster, la)
+        d_cl = _eval(distance_to_l_star, c, la)
+    d_xc = _eval(distance_from_robot, c, xa)
+    return float(alpha * cluster.n_unknown - (d_xc + d_cl))
+
+
+def _eval(fn: DistanceFn | None, point: NDArray[np.float64], other: NDArray[np.float64]) -> float:
+    if fn is None:
+        return float(np.linalg.norm(point - other))
+    value: Any = fn(point[None, :])
+    return float(np.asarray(value, dtype=float).reshape(-1)[0])

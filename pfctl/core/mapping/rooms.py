@@ -1,0 +1,572 @@
+"""Automatic room segmentation of an occupancy map's free space, and door proposals.
+
+Distance-transform segmentation after Bormann et al. (2016), "Room segmentation: survey,
+implementation, and analysis" (§III-B there), with a watershed growth step:
+
+0. **Clean-up.** Non-free specks smaller than ``noise_area`` inside the free space (laser
+   noise, unknown pinholes of a SLAM map) count as free.
+1. **Cores.** The Euclidean distance transform of the free space gives, per free cell, the
+   distance to the nearest non-free cell. Keeping the cells farther than ``core_radius`` from any
+   obstacle cuts the free space at every opening narrower than ``2·core_radius`` — doors — while
+   rooms and corridors wider than that keep a core. ``core_radius`` defaults to half the widest
+   door plus one cell (``door_width/2 + resolution``), so it must stay below half the narrowest
+   room or corridor (a 2 m hall has 1.9 m of free width: fine up to ``door_width ≈ 1.7``).
+   Connected cores (4-connectivity) smaller than ``min_core_area`` are dropped (nooks behind
+   furniture).
+2. **Growth.** The cores are grown back over all free cells by a priority flood on the distance
+   transform (a watershed: the cell with the largest bottleneck distance to a core goes first),
+   so two rooms meet at the narrowest place between them — inside the door opening — and never
+   through a wall. Rooms smaller than ``min_room_area`` are merged into the neighbour they share
+   most free border with. Then each occupied cell (wall, furniture) connected to a room takes
+   the label of the nearest room cell, so a wall between two rooms is split down its middle
+   line; enclosed unlabelled cells join the room around them; unknown cells outside stay
+   unlabelled.
+3. **Polygons.** Each room's label mask is vectorised along the cell edges, its holes (furniture)
+   filled, and the rooms simplified together as a coverage (``shapely.coverage_simplify``), so
+   neighbouring rooms keep sharing exactly the same edge.
+4. **Doors.** Wherever two rooms' free cells touch, a door is proposed: the part of their shared
+   polygon edge that spans the touching cells.
+
+Rooms are named ``room_1``, ``room_2``, … by their centroid, south to north then west to east
+(rows of ``name_row_height`` metres), or after the best-matching region of a reference layout
+(:func:`name_after`).
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+import shapely
+from numpy.typing import NDArray
+from scipy import ndimage
+from shapely.geometry import LineString, MultiLineString, Point, Polygon
+from shapely.geometry.base import BaseGeometry
+from shapely.ops import substring, unary_union
+
+from pfctl.core.mapping.grid import FREE, OCCUPIED, GridGeometry
+from pfctl.core.mapping.house import Door, HouseLayout, Region
+
+XY = tuple[float, float]
+
+_FOUR = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], dtype=bool)
+_EIGHT = np.ones((3, 3), dtype=bool)
+
+
+@dataclass(frozen=True)
+class RoomParams:
+    """Parameters of :func:`segment_rooms` (metres and square metres).
+
+    Attributes:
+        door_width: the widest door opening to cut at. Default 1.0 m (doors are ~0.8–1.0 m).
+        core_radius: the distance-transform threshold of step 1; ``None`` means
+            ``door_width/2 + resolution``. Must be below half the narrowest room or corridor.
+        min_core_area: cores smaller than this are dropped before growing (0.5 m²).
+        min_room_area: grown rooms smaller than this are merged into a neighbour (2.0 m²).
+        simplify_tolerance: coverage simplification of the polygons, roughly the square root of
+            the largest triangle area removed; ``None`` means ``max(0.2, 3·resolution)``.
+        wall_reach: occupied cells (walls, furniture) connected to a room and up to this far from
+            its free space join the nearest room, so polygons reach the wall middle lines and
+            cover furniture; ``None`` (default) means no limit.
+        noise_area: non-free blobs (occupied or unknown, 8-connected) up to this size inside the
+            free space count as free: speckle, pinholes, chair legs (0.1 m²; 0 = off).
+        min_door_width: touching stretches narrower than this are not proposed as doors (0.3 m).
+        name_row_height: centroid rows for the deterministic ``room_N`` order (1.0 m).
+    """
+
+    door_width: float = 1.0
+    core_radius: float | None = None
+    min_core_area: float = 0.5
+    min_room_area: float = 2.0
+    simplify_tolerance: float | None = None
+    wall_reach: float | None = None
+    noise_area: float = 0.1
+    min_door_width: float = 0.3
+    name_row_height: float = 1.0
+
+
+@dataclass(frozen=True)
+class ProposedRoom:
+    """One segmented room: its label in the label image, name, polygon and area (m²)."""
+
+    label: int
+    name: str
+    polygon: tuple[XY, ...]
+    area: float
+
+    def shape(self) -> Polygon:
+        """The polygon as a shapely Polygon."""
+        return Polygon(self.polygon)
+
+
+@dataclass(frozen=True)
+class ProposedDoor:
+    """A door proposed where two rooms touch in free space: the two room names and the segment."""
+
+    between: tuple[str, str]
+    segment: tuple[XY, XY]
+
+    @property
+    def width(self) -> float:
+        """The length of the door segment, metres."""
+        return math.dist(*self.segment)
+
+
+@dataclass(frozen=True)
+class RoomSegmentation:
+    """The result of :func:`segment_rooms`.
+
+    Attributes:
+        labels: int32 image of the grid's shape; 0 = no room (unknown, or unreachable), else the
+            room's ``label``. Free cells and the walls/furniture they touch are labelled.
+        geometry: the grid the labels live on.
+        rooms: the rooms, in name order.
+        doors: the proposed doors, sorted by the names they join.
+        core_radius: the distance-transform threshold that was used, metres.
+    """
+
+    labels: NDArray[np.int32]
+    geometry: GridGeometry
+    rooms: tuple[ProposedRoom, ...]
+    doors: tuple[ProposedDoor, ...] = field(default=())
+    core_radius: float = 0.0
+
+    def layout(self) -> HouseLayout:
+        """The rooms and doors as a :class:`HouseLayout` (no obstacles)."""
+        return HouseLayout(
+            regions=tuple(Region(r.name, r.polygon) for r in self.rooms),
+            doors=tuple(Door(d.between, d.segment) for d in self.doors),
+        )
+
+    def room(self, name: str) -> ProposedRoom:
+        """The room called ``name``; KeyError if there is none."""
+        for r in self.rooms:
+            if r.name == name:
+                return r
+        raise KeyError(name)
+
+
+# --------------------------------------------------------------------------------------------
+# raster steps
+
+
+def _cores(free: NDArray[np.bool_], dist: NDArray[np.float64], radius: float, min_cells: int):
+    """Label the free cells farther than ``radius`` from obstacles; drop small components."""
+    cores, n = ndimage.label(free & (dist > radius), structure=_FOUR)
+    if n == 0:
+        return cores.astype(np.int32)
+    sizes = ndimage.sum_labels(np.ones_like(cores), cores, index=np.arange(1, n + 1))
+    keep = np.zeros(n + 1, dtype=np.int32)
+    kept = [i + 1 for i, s in enumerate(sizes) if s >= min_cells]
+    for new, old in enumerate(kept, start=1):
+        keep[old] = new
+    return keep[cores]
+
+
+def _despeckle(free: NDArray[np.bool_], max_cells: int) -> NDArray[np.bool_]:
+    """Free space with every non-free blob of at most ``max_cells`` cells (8-connected) inside it
+    counted as free: laser speckle and unknown pinholes of a mapped room, not walls."""
+    blobs, n = ndimage.label(~free, structure=_EIGHT)
+    if n == 0:
+        return free
+    sizes = np.bincount(blobs.ravel(), minlength=n + 1)
+    small = sizes <= max_cells
+    small[0] = False
+    return free | small[blobs]
+
+
+def _watershed(
+    labels: NDArray[np.int32], free: NDArray[np.bool_], dist: NDArray[np.float64]
+) -> NDArray[np.int32]:
+    """Grow ``labels`` over ``free`` by a priority flood: largest bottleneck distance first.
+
+    Each unlabelled free cell receives the label of the first neighbour that reaches it along the
+    path whose smallest distance-transform value is largest (ties: first come, first served), so
+    fronts from two cores meet at the narrowest point between them.
+    """
+    out = labels.copy()
+    h, w = out.shape
+    heap: list[tuple[float, int, int, int]] = []
+    counter = 0
+    rows, cols = np.nonzero(out)
+    for r, c in zip(rows.tolist(), cols.tolist(), strict=True):
+        heap.append((-float(dist[r, c]), counter, r, c))
+        counter += 1
+    heapq.heapify(heap)
+    free_l = free.tolist()
+    dist_l = dist.tolist()
+    out_l = out.tolist()
+    while heap:
+        neg, _, r, c = heapq.heappop(heap)
+        lab = out_l[r][c]
+        for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
+            if 0 <= rr < h and 0 <= cc < w and free_l[rr][cc] and out_l[rr][cc] == 0:
+                out_l[rr][cc] = lab
+                prio = max(neg, -dist_l[rr][cc])
+                heapq.heappush(heap, (prio, counter, rr, cc))
+                counter += 1
+    return np.asarray(out_l, dtype=np.int32)
+
+
+def _grow_into(
+    labels: NDArray[np.int32], allowed: NDArray[np.bool_], reach_cells: float
+) -> NDArray[np.int32]:
+    """Give ``allowed`` unlabelled cells within ``reach_cells`` the label of the nearest room.
+
+    Only cells of the ``allowed ∪ labelled`` components (8-connectivity) that hold a room are
+    considered. Nearest in the Euclidean sense (``distance_transform_edt`` with indices), so a
+    wall between two rooms is split down its middle line and a T-junction splits cleanly.
+    """
+    comp, _ = ndimage.label(allowed | (labels > 0), structure=_EIGHT)
+    holding = np.unique(comp[labels > 0])
+    connected = np.isin(comp, holding[holding > 0])
+    dist, (ir, ic) = ndimage.distance_transform_edt(labels == 0, return_indices=True)
+    take = allowed & connected & (labels == 0) & (dist <= reach_cells)
+    out = labels.copy()
+    out[take] = labels[ir[take], ic[take]]
+    return out
+
+
+def _relabel(labels: NDArray[np.int32]) -> NDArray[np.int32]:
+    """Renumber the labels present to 1..n in order of first appearance (row-major)."""
+    present = [v for v in dict.fromkeys(labels[labels > 0].tolist())]
+    lut = np.zeros(int(labels.max()) + 1, dtype=np.int32)
+    for new, old in enumerate(present, start=1):
+        lut[old] = new
+    return lut[labels]
+
+
+def _contacts(labels: NDArray[np.int32], mask: NDArray[np.bool_]) -> dict[tuple[int, int], int]:
+    """Count 4-neighbour contacts between different labels among cells of ``mask``."""
+    counts: dict[tuple[int, int], int] = {}
+    for a, b, ma, mb in (
+        (labels[:, :-1], labels[:, 1:], mask[:, :-1], mask[:, 1:]),
+        (labels[:-1, :], labels[1:, :], mask[:-1, :], mask[1:, :]),
+    ):
+        sel = ma & mb & (a > 0) & (b > 0) & (a != b)
+        for x, y in zip(a[sel].tolist(), b[sel].tolist(), strict=True):
+            key = (min(x, y), max(x, y))
+            counts[key] = counts.get(key, 0) + 1
+    return counts
+
+
+def _merge_small(labels: NDArray[np.int32], min_cells: int) -> NDArray[np.int32]:
+    """Merge rooms smaller than ``min_cells`` into the neighbour they touch most; drop if none."""
+    out = labels.copy()
+    while True:
+        ids, sizes = np.unique(out[out > 0], return_counts=True)
+        small = [(int(s), int(i)) for i, s in zip(ids, sizes, strict=True) if s < min_cells]
+        if not small:
+            return out
+        _, victim = min(small)
+        contacts = _contacts(out, out > 0)
+        best = max(
+            ((n, (b if a == victim else a)) for (a, b), n in contacts.items() if victim in (a, b)),
+            default=None,
+        )
+        out[out == victim] = best[1] if best else 0
+
+
+def _fill_holes(labels: NDArray[np.int32]) -> NDArray[np.int32]:
+    """Give each room the unlabelled cells it encloses (furniture islands, unknown pockets)."""
+    out = labels.copy()
+    for lab in np.unique(labels[labels > 0]).tolist():
+        filled = ndimage.binary_fill_holes(labels == lab)
+        out[filled & (out == 0)] = lab
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# vectorisation
+
+
+def _label_polygons(
+    labels: NDArray[np.int32], geometry: GridGeometry, tolerance: float
+) -> dict[int, Polygon]:
+    """One simplified polygon per label, edge-matched with its neighbours (a coverage)."""
+    res = geometry.resolution
+    ox, oy = geometry.origin
+    pad = np.pad(labels, 1, constant_values=0)
+    segs: list[tuple[tuple[float, float], tuple[float, float]]] = []
+    # vertical cell edges: between column c-1 and c (padded indices), at x = ox + (c-1)·res
+    diff_v = pad[1:-1, :-1] != pad[1:-1, 1:]
+    for r, c in zip(*np.nonzero(diff_v), strict=True):
+        x = ox + c * res
+        segs.append(((x, oy + r * res), (x, oy + (r + 1) * res)))
+    diff_h = pad[:-1, 1:-1] != pad[1:, 1:-1]
+    for r, c in zip(*np.nonzero(diff_h), strict=True):
+        y = oy + r * res
+        segs.append(((ox + c * res, y), (ox + (c + 1) * res, y)))
+    if not segs:
+        return {}
+    lines = shapely.line_merge(MultiLineString(segs))
+    faces = list(shapely.get_parts(shapely.polygonize(list(shapely.get_parts(lines)))))
+    by_label: dict[int, list[Polygon]] = {}
+    for face in faces:
+        p = face.representative_point()
+        r, c = geometry.world_to_cell(np.array([p.x, p.y]))
+        if not geometry.in_bounds(r, c):
+            continue
+        lab = int(labels[int(r), int(c)])
+        if lab > 0:
+            by_label.setdefault(lab, []).append(face)
+    keys = sorted(by_label)
+    merged = [unary_union(by_label[k]) for k in keys]
+    simplified = shapely.coverage_simplify(np.array(merged, dtype=object), tolerance)
+    out: dict[int, Polygon] = {}
+    for k, g in zip(keys, simplified, strict=True):
+        parts = [p for p in shapely.get_parts(g) if isinstance(p, Polygon)]
+        if parts:
+            out[k] = max(parts, key=lambda p: p.area)
+    return out
+
+
+def _ring(poly: Polygon, res: float) -> tuple[XY, ...]:
+    """The exterior ring, without collinear vertices, counter-clockwise from its lowest (then
+    leftmost) vertex, without the closing point, rounded to the grid."""
+    outline = Polygon(poly.exterior).simplify(0.0)  # drop collinear vertices (junctions)
+    ring = shapely.orient_polygons(outline).exterior.coords[:-1]
+    digits = max(3, -math.floor(math.log10(res)) + 1) if res < 1 else 3
+    pts = [(round(x, digits) + 0.0, round(y, digits) + 0.0) for x, y in ring]
+    start = min(range(len(pts)), key=lambda i: (pts[i][1], pts[i][0]))
+    return tuple(pts[start:] + pts[:start])
+
+
+def _door_segment(
+    shared: BaseGeometry, points: NDArray[np.float64], res: float
+) -> tuple[XY, XY] | None:
+    """The part of the shared edge ``shared`` that spans ``points`` (plus half a cell each way)."""
+    lines = [g for g in shapely.get_parts(shared) if isinstance(g, LineString | MultiLineString)]
+    if not lines:
+        return None
+    merged = shapely.line_merge(unary_union(lines))
+    candidates = list(shapely.get_parts(merged))
+    centre = Point(points.mean(axis=0))
+    line = min(candidates, key=lambda g: g.distance(centre))
+    ts = [line.project(Point(p)) for p in points]
+    t0, t1 = max(0.0, min(ts) - res / 2.0), min(line.length, max(ts) + res / 2.0)
+    if t1 - t0 <= 0:
+        return None
+    seg = substring(line, t0, t1)
+    coords = list(seg.coords)
+    a, b = coords[0], coords[-1]
+    digits = max(3, -math.floor(math.log10(res)) + 1) if res < 1 else 3
+    a = (round(a[0], digits) + 0.0, round(a[1], digits) + 0.0)
+    b = (round(b[0], digits) + 0.0, round(b[1], digits) + 0.0)
+    return (a, b) if a <= b else (b, a)
+
+
+def _doors(
+    labels: NDArray[np.int32],
+    free: NDArray[np.bool_],
+    geometry: GridGeometry,
+    polygons: dict[int, Polygon],
+    min_width: float,
+) -> list[tuple[tuple[int, int], tuple[XY, XY]]]:
+    """Doors where two labels touch in free space: one per connected stretch of contact."""
+    res = geometry.resolution
+    pairs: dict[tuple[int, int], list[tuple[float, float]]] = {}
+    ox, oy = geometry.origin
+    for axis in (0, 1):
+        if axis == 1:
+            a, b = labels[:, :-1], labels[:, 1:]
+            fa, fb = free[:, :-1], free[:, 1:]
+        else:
+            a, b = labels[:-1, :], labels[1:, :]
+            fa, fb = free[:-1, :], free[1:, :]
+        sel = fa & fb & (a > 0) & (b > 0) & (a != b)
+        rr, cc = np.nonzero(sel)
+        for r, c, la, lb in zip(rr, cc, a[sel], b[sel], strict=True):
+            # midpoint between the two touching cell centres
+            x = ox + (c + 1.0 if axis == 1 else c + 0.5) * res
+            y = oy + (r + 1.0 if axis == 0 else r + 0.5) * res
+            key = (int(min(la, lb)), int(max(la, lb)))
+            pairs.setdefault(key, []).append((x, y))
+    doors: list[tuple[tuple[int, int], tuple[XY, XY]]] = []
+    for key in sorted(pairs):
+        if key[0] not in polygons or key[1] not in polygons:
+            continue
+        pts = np.asarray(pairs[key])
+        # split the contact points into connected stretches (neighbours within 1.5 cells)
+        mask = np.zeros(geometry.shape, dtype=bool)
+        rows, cols = geometry.world_to_cell(pts)
+        mask[np.clip(rows, 0, geometry.height - 1), np.clip(cols, 0, geometry.width - 1)] = True
+        comp, n = ndimage.label(ndimage.binary_dilation(mask, structure=_EIGHT), _EIGHT)
+        which = comp[np.clip(rows, 0, geometry.height - 1), np.clip(cols, 0, geometry.width - 1)]
+        shared = polygons[key[0]].intersection(polygons[key[1]])
+        for k in range(1, n + 1):
+            stretch = pts[which == k]
+            if len(stretch) == 0:
+                continue
+            seg = _door_segment(shared, stretch, res)
+            if seg is not None and math.dist(*seg) >= min_width:
+                doors.append((key, seg))
+    return doors
+
+
+def _order(polygons: dict[int, Polygon], row_height: float) -> list[int]:
+    """Labels sorted by centroid: rows of ``row_height`` m south to north, then west to east."""
+
+    def key(lab: int) -> tuple[int, float, float]:
+        c = polygons[lab].centroid
+        return (math.floor(c.y / row_height), c.x, c.y)
+
+    return sorted(polygons, key=key)
+
+
+# --------------------------------------------------------------------------------------------
+# public API
+
+
+def segment_free_space(
+    states: NDArray[np.integer],
+    geometry: GridGeometry,
+    params: RoomParams | None = None,
+) -> RoomSegmentation:
+    """Segment a trinary map (:data:`FREE`/:data:`OCCUPIED`/:data:`UNKNOWN` per cell) into rooms.
+
+    See the module docstring for the method. Raises ``ValueError`` if no room is found (no free
+    core wider than ``2·core_radius``).
+    """
+    params = params or RoomParams()
+    res = geometry.resolution
+    states = np.asarray(states)
+    if states.shape != geometry.shape:
+        raise ValueError(f"states of shape {states.shape} do not match the grid {geometry.shape}")
+    free = states == FREE
+    occupied = states == OCCUPIED
+    if params.noise_area > 0:
+        free = _despeckle(free, max(1, math.floor(params.noise_area / (res * res))))
+        occupied &= ~free
+    radius = params.core_radius if params.core_radius is not None else params.door_width / 2 + res
+    cell_area = res * res
+
+    dist = ndimage.distance_transform_edt(free) * res
+    cores = _cores(free, dist, radius, max(1, math.ceil(params.min_core_area / cell_area)))
+    if cores.max() == 0:
+        raise ValueError(
+            f"no room found: no free space farther than {radius:.2f} m from an obstacle"
+        )
+    labels = _watershed(cores, free, dist)
+    labels = _merge_small(labels, max(1, math.ceil(params.min_room_area / cell_area)))
+    reach = math.inf if params.wall_reach is None else params.wall_reach / res
+    labels = _grow_into(labels, occupied, reach)
+    labels = _fill_holes(labels)
+    labels = _relabel(labels)
+
+    tolerance = (
+        params.simplify_tolerance if params.simplify_tolerance is not None else max(0.2, 3 * res)
+    )
+    polygons = _label_polygons(labels, geometry, tolerance)
+    order = _order(polygons, params.name_row_height)
+    names = {lab: f"room_{i}" for i, lab in enumerate(order, start=1)}
+    rooms = tuple(
+        ProposedRoom(
+            label=lab,
+            name=names[lab],
+            polygon=_ring(polygons[lab], res),
+            area=round(float(polygons[lab].area), 3),
+        )
+        for lab in order
+    )
+    doors = tuple(
+        sorted(
+            (
+                ProposedDoor(between=(names[a], names[b]), segment=seg)
+                for (a, b), seg in _doors(labels, free, geometry, polygons, params.min_door_width)
+            ),
+            key=lambda d: (d.between, d.segment),
+        )
+    )
+    return RoomSegmentation(
+        labels=labels, geometry=geometry, rooms=rooms, doors=doors, core_radius=radius
+    )
+
+
+def segment_rooms(grid: object, params: RoomParams | None = None) -> RoomSegmentation:
+    """Segment an :class:`~pfctl.core.mapping.grid.OccupancyGrid` (its ``states()`` and
+    ``geometry``)."""
+    return segment_free_space(grid.states(), grid.geometry, params)  # type: ignore[attr-defined]
+
+
+def polygon_iou(a: BaseGeometry, b: BaseGeometry) -> float:
+    """Intersection over union of two shapely areas (0 when both are empty)."""
+    union = a.union(b).area
+    return float(a.intersection(b).area / union) if union > 0 else 0.0
+
+
+def match_regions(
+    proposed: list[Region] | tuple[Region, ...],
+    reference: list[Region] | tuple[Region, ...],
+    min_iou: float = 0.5,
+) -> dict[str, tuple[str, float]]:
+    """Match proposed regions to reference regions one-to-one by polygon IoU.
+
+    Greedy on decreasing IoU (optimal for the near-disjoint rooms of a house). Returns
+    ``{proposed name: (reference name, iou)}`` for pairs with IoU ≥ ``min_iou``.
+    """
+    scores = []
+    for p in proposed:
+        pp = Polygon(p.polygon)
+        for r in reference:
+            iou = polygon_iou(pp, Polygon(r.polygon))
+            if iou >= min_iou:
+                scores.append((iou, p.name, r.name))
+    scores.sort(key=lambda s: (-s[0], s[1], s[2]))
+    used_p: set[str] = set()
+    used_r: set[str] = set()
+    out: dict[str, tuple[str, float]] = {}
+    for iou, pn, rn in scores:
+        if pn in used_p or rn in used_r:
+            continue
+        used_p.add(pn)
+        used_r.add(rn)
+        out[pn] = (rn, iou)
+    return out
+
+
+def name_after(
+    segmentation: RoomSegmentation, reference: HouseLayout, min_iou: float = 0.5
+) -> RoomSegmentation:
+    """Rename the rooms after the reference regions they match (IoU ≥ ``min_iou``).
+
+    Unmatched rooms keep a ``room_N`` name that does not clash with a reference name.
+    """
+    matches = match_regions(segmentation.layout().regions, reference.regions, min_iou)
+    taken = {rn for rn, _ in matches.values()}
+    names: dict[str, str] = {}
+    counter = 0
+    for room in segmentation.rooms:
+        if room.name in matches:
+            names[room.name] = matches[room.name][0]
+        else:
+            counter += 1
+            while f"room_{counter}" in taken:
+                counter += 1
+            names[room.name] = f"room_{counter}"
+    rooms = tuple(replace(r, name=names[r.name]) for r in segmentation.rooms)
+    doors = tuple(
+        sorted(
+            (
+                ProposedDoor(between=(names[d.between[0]], names[d.between[1]]), segment=d.segment)
+                for d in segmentation.doors
+            ),
+            key=lambda d: (d.between, d.segment),
+        )
+    )
+    return replace(segmentation, rooms=rooms, doors=doors)
+
+
+__all__ = [
+    "ProposedDoor",
+    "ProposedRoom",
+    "RoomParams",
+    "RoomSegmentation",
+    "match_regions",
+    "name_after",
+    "polygon_iou",
+    "segment_free_space",
+    "segment_rooms",
+]

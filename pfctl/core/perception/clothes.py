@@ -1,0 +1,255 @@
+"""Clothing colour histograms and their similarity (Algorithm 2, §II-E).
+
+The paper compares the clothes of a candidate with the target's by histogram intersection
+(Swain & Ballard 1991), normalised by the target's mass:
+
+    S(I, T) = Σ_j min(I_j, T_j) / Σ_j T_j                                  (Algorithm 2)
+
+A person's clothes are two histograms, upper and lower body, of the pixels of that part in a
+colour space (HSV by default: hue separates colours under changing light better than RGB), with
+``bins`` per channel, each normalised to sum 1.
+
+**Body split** (:func:`body_parts`). The body's pixels are its segmentation mask when the
+detector gives one, else the central half of its box's width (a box holds background at its
+sides). Rows: with keypoints, the upper body runs from ``neck`` to ``mid_hip`` and the lower body
+from ``mid_hip`` down to ``ankles`` (or the box's bottom); without, fixed fractions of the box
+height from human proportions (Drillis & Contini 1966: shoulders at ~18 %, hips at ~48-53 % of
+the height from the top): upper 20-48 %, lower 55-95 %. The gap around the hips keeps the belt
+line (either colour) out of both.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+
+from pfctl.core.perception.faces import Box
+
+ColorSpace = Literal["hsv", "rgb", "lab"]
+
+#: Box-height fractions (from the top) of the upper and lower body when no keypoints are known.
+UPPER_ROWS = (0.20, 0.48)
+LOWER_ROWS = (0.55, 0.95)
+#: Without a mask, the central fraction of the box width taken as the body.
+CENTRAL_WIDTH = 0.5
+
+#: OpenCV's 8-bit channel ranges per colour space (hue is 0..180 in HSV).
+_RANGES: dict[str, list[float]] = {
+    "hsv": [0, 180, 0, 256, 0, 256],
+    "rgb": [0, 256, 0, 256, 0, 256],
+    "lab": [0, 256, 0, 256, 0, 256],
+}
+
+
+@dataclass(frozen=True)
+class ClothesParams:
+    """Colour space and bins of the clothing histograms (``perception.identity``)."""
+
+    color_space: ColorSpace = "hsv"
+    bins: tuple[int, int, int] = (16, 4, 4)
+
+    @property
+    def size(self) -> int:
+        """Number of bins of a flattened histogram."""
+        return int(np.prod(self.bins))
+
+
+def convert(rgb: np.ndarray, space: ColorSpace) -> np.ndarray:
+    """An ``(h, w, 3) uint8`` RGB image in ``space`` (OpenCV's 8-bit conventions)."""
+    import cv2
+
+    img = np.ascontiguousarray(rgb[..., :3], dtype=np.uint8)
+    if space == "hsv":
+        return cv2.cvtColor(img, cv2.COLOR_RGB2HSV)
+    if space == "lab":
+        return cv2.cvtColor(img, cv2.COLOR_RGB2LAB)
+    return img
+
+
+def color_histogram(
+    image: np.ndarray, mask: np.ndarray, params: ClothesParams, converted: bool = False
+) -> np.ndarray | None:
+    """The normalised (sum 1) flattened histogram of the pixels ``mask`` ``(h, w) bool`` of an
+    RGB ``image`` (or of an image already in ``params.color_space`` when ``converted``); None
+    when the mask selects no pixel.
+
+    The bins are **soft** (linear interpolation, as in Lowe's SIFT descriptors): a pixel adds to
+    the two nearest bins of each channel in proportion to its distance from their centres, so a
+    colour near a bin edge does not jump from one bin to the other when the light changes a
+    little (hard 4-level value bins split the same red shirt at V = 128 between a dim hall and a
+    bright office: S fell from 0.99 to 0.26). Hue is circular in HSV (bin 0 neighbours the last
+    bin); the other channels are clamped at their ends.
+
+    Each pixel's bins and weights are read from tables over the 8-bit values
+    (:func:`_soft_bins`), the same numbers as computed from the pixel; ValueError for an image
+    that is not 8-bit.
+    """
+    if not np.any(mask):
+        return None
+    img = image if converted else convert(image, params.color_space)
+    if img.dtype != np.uint8:
+        raise ValueError(f"color_histogram needs an 8-bit image, got {img.dtype}")
+    pixels = img[mask.astype(bool)]
+    pairs, third = _soft_bins(params.color_space, tuple(int(b) for b in params.bins))
+    first_two = pixels[:, 0].astype(np.intp) * 256 + pixels[:, 1]
+    last = pixels[:, 2]
+    corners = [(k[last], f[last]) for k, f in third]
+    stride = params.bins[2]
+    hist = np.zeros(params.size)
+    for pair_index, pair_weight in pairs:  # the 8 corners of each pixel's trilinear cell
+        index = pair_index[first_two] * stride
+        weight = pair_weight[first_two]
+        for k, f in corners:
+            hist += np.bincount(index + k, weights=weight * f, minlength=params.size)
+    total = float(hist.sum())
+    return hist / total if total > 0 else None
+
+
+@functools.lru_cache(maxsize=8)
+def _soft_bins(
+    space: str, bins: tuple[int, ...]
+) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
+    """Lookup tables of :func:`color_histogram` over the 8-bit channel values: for channels 0
+    and 1 together (index ``v0 · 256 + v1``), the flat bin ``k0 · bins[1] + k1`` and weight
+    ``f0 · f1`` of each of their four pairs of neighbouring bins; for channel 2, its two bins
+    and weights. Each entry is computed with the same floating-point operations, in the same
+    order, as from the pixel itself, so the histogram is the same, bit for bit, as computing
+    every pixel's bins and weights (~2x faster: a person near the camera has ~35 000 pixels)."""
+    ranges = _RANGES[space]
+    values = np.arange(256, dtype=np.float64)
+    channels: list[list[tuple[np.ndarray, np.ndarray]]] = []
+    for channel, n in enumerate(bins):
+        lo, hi = ranges[2 * channel], ranges[2 * channel + 1]
+        u = (values - lo) / (hi - lo) * n - 0.5  # bin-centre coordinates
+        k0 = np.floor(u)
+        frac = u - k0
+        k0 = k0.astype(np.intp)
+        k1 = k0 + 1
+        if space == "hsv" and channel == 0:  # hue is circular
+            k0, k1 = k0 % n, k1 % n
+        else:
+            k0, k1 = np.clip(k0, 0, n - 1), np.clip(k1, 0, n - 1)
+        channels.append([(k0, 1.0 - frac), (k1, frac)])
+    pairs = [
+        ((ka[:, None] * bins[1] + kb[None, :]).ravel(), (fa[:, None] * fb[None, :]).ravel())
+        for ka, fa in channels[0]
+        for kb, fb in channels[1]
+    ]
+    return pairs, channels[2]
+
+
+def histogram_intersection(candidate: np.ndarray, target: np.ndarray) -> float:
+    """Algorithm 2's clothes similarity ``S = Σ min(I_j, T_j) / Σ T_j`` of a candidate's
+    histogram ``I`` against the target's ``T`` (1: ``I`` covers ``T``; 0: disjoint)."""
+    i = np.asarray(candidate, dtype=float).ravel()
+    t = np.asarray(target, dtype=float).ravel()
+    if i.shape != t.shape:
+        raise ValueError(f"histograms differ in size: {i.size} vs {t.size}")
+    total = float(t.sum())
+    return float(np.minimum(i, t).sum() / total) if total > 0 else 0.0
+
+
+def _part_rows(
+    box: Box, keypoints: dict[str, tuple[float, float]] | None
+) -> tuple[float, float, float, float]:
+    """Image rows ``[u0, u1)`` of the upper and ``[l0, l1)`` of the lower body (module
+    docstring)."""
+    y0, y1 = box[1], box[3]
+    kp = keypoints or {}
+    height = y1 - y0
+    if "neck" in kp and "mid_hip" in kp:
+        top, hip = kp["neck"][1], kp["mid_hip"][1]
+        gap = 0.04 * max(hip - top, 1.0)
+        bottom = kp["ankles"][1] if "ankles" in kp else y1
+        upper_rows = (top + gap, hip - gap)
+        lower_rows = (hip + gap, bottom)
+    else:
+        upper_rows = (y0 + UPPER_ROWS[0] * height, y0 + UPPER_ROWS[1] * height)
+        lower_rows = (y0 + LOWER_ROWS[0] * height, y0 + LOWER_ROWS[1] * height)
+    u0, u1, l0, l1 = (round(float(r), 6) for r in (*upper_rows, *lower_rows))  # no 110.00000001
+    return u0, u1, l0, l1
+
+
+def _body(
+    shape: tuple[int, int], box: Box, mask: np.ndarray | None, window: tuple[int, int, int, int]
+) -> np.ndarray:
+    """The body's pixels (its mask, else the central part of its box) inside ``window`` =
+    rows ``[r0, r1)``, columns ``[c0, c1)`` of the image."""
+    r0, r1, c0, c1 = window
+    if mask is not None:
+        return mask[r0:r1, c0:c1].astype(bool)
+    h, w = shape
+    x0, y0, x1, y1 = box
+    body = np.zeros((r1 - r0, c1 - c0), dtype=bool)
+    half = CENTRAL_WIDTH * (x1 - x0) / 2
+    cx = (x0 + x1) / 2
+    rows = slice(max(0, y0, r0) - r0, min(h, y1, r1) - r0)
+    cols = slice(max(0, int(cx - half), c0) - c0, min(w, int(np.ceil(cx + half)), c1) - c0)
+    if rows.start < rows.stop and cols.start < cols.stop:
+        body[rows, cols] = True
+    return body
+
+
+def body_parts(
+    shape: tuple[int, int],
+    box: Box,
+    mask: np.ndarray | None = None,
+    keypoints: dict[str, tuple[float, float]] | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The upper- and lower-body pixel masks ``(h, w) bool`` of a person (see the module
+    docstring for the split)."""
+    _, upper, lower = body_parts_window(shape, box, mask, keypoints, crop=False)
+    return upper, lower
+
+
+def body_parts_window(
+    shape: tuple[int, int],
+    box: Box,
+    mask: np.ndarray | None = None,
+    keypoints: dict[str, tuple[float, float]] | None = None,
+    *,
+    crop: bool = True,
+) -> tuple[tuple[int, int, int, int], np.ndarray, np.ndarray]:
+    """:func:`body_parts` cut to the window that holds them: ``((r0, r1, c0, c1), upper,
+    lower)`` with the masks of rows ``[r0, r1)`` and columns ``[c0, c1)`` of the image (the
+    pixels of Algorithm 2's clothing histograms).
+
+    The window is the person's box inside the image (the whole image when ``crop`` is False,
+    or when a ``mask`` has pixels outside the box), so the masks select the same pixels, in
+    the same row-major order, as the full-image ones: a histogram of them is the same, bit for
+    bit, for a fraction of the work.
+    """
+    h, w = shape
+    window = (0, h, 0, w)
+    if crop:
+        x0, y0, x1, y1 = box
+        cut = (max(0, y0), min(h, y1), max(0, x0), min(w, x1))
+        if cut[0] >= cut[1] or cut[2] >= cut[3]:
+            cut = (0, 0, 0, 0)
+        inside = mask is None or np.count_nonzero(
+            mask[cut[0] : cut[1], cut[2] : cut[3]]
+        ) == np.count_nonzero(mask)
+        if inside:
+            window = cut
+    body = _body(shape, box, mask, window)
+    u0, u1, l0, l1 = _part_rows(box, keypoints)
+    rows = np.arange(window[0], window[1])[:, None]
+    upper = body & (rows >= u0) & (rows < u1)
+    lower = body & (rows >= l0) & (rows < l1)
+    return window, upper, lower
+
+
+__all__ = [
+    "LOWER_ROWS",
+    "UPPER_ROWS",
+    "ClothesParams",
+    "ColorSpace",
+    "body_parts",
+    "body_parts_window",
+    "color_histogram",
+    "convert",
+    "histogram_intersection",
+]

@@ -1,0 +1,1 @@
+"""Target identification, Algorithm 2 (§II-E): legs, then face, then clothes."""

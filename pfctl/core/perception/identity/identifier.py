@@ -1,0 +1,785 @@
+"""Target identification, Algorithm 2 of the paper (§II-E): legs, then face, then clothes.
+
+The paper decides which tracked person is the target by filtering the candidates: first those
+with legs (the laser's leg detector, so a poster or a coat on a chair is not a person), then by
+face (an embedding distance below ``face_distance``), then by clothes (the histogram intersection
+``S = Σ min(I, T) / Σ T`` of :mod:`pfctl.core.perception.clothes` above ``clothes_similarity``).
+
+Faces are trusted most. A face match confirms a track as the target, a face mismatch rejects it
+even if the clothes match (a look-alike in the same shirt); clothes decide only when no face has
+been seen. The paper applies the filter to each frame; here **the decision and its evidence are
+kept per track over time** (:class:`TrackIdentity`), so one good face match carries the track
+through the later frames where the person turns their back, and a mismatching face is remembered
+the same way. When a track has seen faces both ways (a bad detection), the median of its face
+distances decides.
+
+Faces are searched only when it is worth it: until a track has ``face_settled`` face samples, then
+every ``face_recheck_s``; and a track whose last ``face_miss_limit`` searches found no face (the
+back of the head, a face turned away) is searched only every ``face_miss_backoff_s`` until one
+is found again.
+
+Clothes are measured on every observation until the track's clothes evidence is **settled**:
+``clothes_settled`` samples and either a face deciding the track (then clothes no longer enter
+Algorithm 2's decision at all) or a mean similarity at least ``clothes_margin`` away from the
+``clothes_similarity`` threshold. A settled track's clothes are measured again only every
+``clothes_recheck_s`` (a histogram pair costs ~0.5–1 ms per person at 320x240, six people ~5 ms
+a frame; benchmarks/bench_identity.py). The decision is the mean S over the samples; a settled
+track has fewer of them, each weighing more, so new evidence moves its mean about as fast in
+time as before, and a track whose mean comes back within the margin of the threshold is measured
+on every frame again. Which tracks Algorithm 2 names is unchanged on the tests' episodes.
+
+The face search itself (dlib's HOG detector and ResNet embedding, ~75–90 ms per face) runs inline
+by default, or — given a :class:`~pfctl.core.perception.face_worker.FaceWorker` — in a worker
+process: the head crop is submitted and the result folded into the track's evidence when it comes
+back (a track deleted meanwhile is skipped). How results are folded in is ``face_timing``:
+
+- ``deterministic`` (the simulator): a search submitted with the frame stamped t is folded in at
+  the first observation stamped t + ``face_latency_s`` or later, waiting for the worker then if
+  it is not done; at most ``max_in_flight`` searches are out, counted by the identifier itself.
+  Which searches are made and when their results count depend on the frames' stamps only, so a
+  seeded simulation gives the same episode however fast the machine is;
+- ``realtime`` (a real robot): whatever has come back is folded in at each observation, nothing
+  waits; a search the worker refuses (it is busy) is tried again on a later frame.
+
+:class:`TargetProfile` is what ``pfctl learn-target`` writes: the target's upper and lower
+clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, saved as a versioned
+``.npz`` (no pickles).
+"""
+
+from __future__ import annotations
+
+import enum
+import io
+import itertools
+import math
+import os
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Literal
+
+import numpy as np
+
+from pfctl.core.atomic_files import atomic_write
+from pfctl.core.perception.clothes import (
+    ClothesParams,
+    ColorSpace,
+    body_parts_window,
+    color_histogram,
+    convert,
+    histogram_intersection,
+)
+from pfctl.core.perception.faces import (
+    EMBEDDING_SIZE,
+    Box,
+    Face,
+    FaceEncoder,
+    FaceParams,
+    face_distance,
+)
+from pfctl.core.perception.vision import PersonDetection
+from pfctl.errors import UserError
+
+if TYPE_CHECKING:
+    from pfctl.core.perception.face_worker import FaceResult, FaceWorker
+
+#: Version of the profile file format.
+PROFILE_VERSION = 1
+#: At most this many face embeddings are kept in a profile (spread over the samples).
+MAX_PROFILE_FACES = 32
+#: A head region narrower than this (pixels) is not searched for a face (too far).
+MIN_HEAD_PX = 12
+#: Stamps this close count as equal (simulated clocks add up float steps).
+STAMP_EPS = 1e-6
+
+#: Numbers the identifiers, for their job keys.
+_IDENTIFIERS = itertools.count()
+
+FaceTiming = Literal["deterministic", "realtime"]
+"""When a face worker's results are folded in (module docstring)."""
+
+
+@dataclass(frozen=True)
+class IdentityParams:
+    """Thresholds of Algorithm 2 and how appearances are measured (``perception.identity``)."""
+
+    face_distance: float = 0.6
+    """Face-embedding distance below which faces match (dlib's operating point)."""
+    clothes_similarity: float = 0.6
+    """Histogram intersection S at or above which clothes match."""
+    clothes: ClothesParams = field(default_factory=ClothesParams)
+    face: FaceParams = field(default_factory=FaceParams)
+    faces: bool = True
+    """Look for faces at all (False: clothes only, e.g. without dlib's models)."""
+    face_settled: int = 3
+    """A track with this many face samples is settled: its face is looked at again only every
+    ``face_recheck_s`` (an embedding costs ~90 ms on one core; see benchmarks/bench_identity)."""
+    face_recheck_s: float = 1.0
+    """How often a settled track's face is embedded again, seconds."""
+    face_miss_limit: int = 3
+    """After this many face searches in a row found no face (the back of the head), the track
+    is searched only every ``face_miss_backoff_s`` until a face is found again."""
+    face_miss_backoff_s: float = 0.5
+    """How often a track whose face searches keep missing is searched, seconds."""
+    clothes_settled: int = 10
+    """A track with this many clothes samples is settled when a face decides it or its mean
+    similarity is at least ``clothes_margin`` from ``clothes_similarity`` (module docstring)."""
+    clothes_margin: float = 0.15
+    """How far from the threshold a settled track's mean clothes similarity is."""
+    clothes_recheck_s: float = 0.5
+    """How often a settled track's clothes are measured, seconds (0: every observation)."""
+    face_timing: FaceTiming = "deterministic"
+    """With a face worker: ``deterministic`` (simulator) or ``realtime`` (robot)."""
+    face_latency_s: float = 0.1
+    """With a face worker in ``deterministic`` timing: a search of the frame stamped t counts
+    from the first observation stamped t + this (about what an embedding takes)."""
+
+
+@dataclass(frozen=True)
+class Appearance:
+    """What one detection looks like: clothing histograms (None when that part was not seen)
+    and the face embedding (None when no face was found)."""
+
+    upper: np.ndarray | None
+    lower: np.ndarray | None
+    face: np.ndarray | None = None
+    face_box: Box | None = None
+
+
+def head_region(detection: PersonDetection) -> Box:
+    """Where to look for the face: the detector's head box (widened by a quarter), else the top
+    quarter of the body box's central 60 %."""
+    if detection.head_box is not None:
+        x0, y0, x1, y1 = detection.head_box
+        mx, my = (x1 - x0) // 4 + 1, (y1 - y0) // 4 + 1
+        return x0 - mx, y0 - my, x1 + mx, y1 + my
+    x0, y0, x1, y1 = detection.box
+    w, h = x1 - x0, y1 - y0
+    return int(x0 + 0.2 * w), y0, math.ceil(x1 - 0.2 * w), int(y0 + 0.25 * h)
+
+
+def _head_cut(detection: PersonDetection, shape: tuple[int, ...]) -> bool:
+    """Whether the detector's head box touches the image border (a cut face embeds badly)."""
+    if detection.head_box is None:
+        return False
+    x0, y0, x1, y1 = detection.head_box
+    return x0 <= 0 or y0 <= 0 or x1 >= shape[1] or y1 >= shape[0]
+
+
+def face_region(detection: PersonDetection, shape: tuple[int, ...]) -> Box | None:
+    """The :func:`head_region` to search for the detection's face in an image of ``shape``, or
+    None when it is not worth searching: the head box touches the border (a cut face embeds
+    badly) or the region is narrower than :data:`MIN_HEAD_PX`."""
+    if _head_cut(detection, shape):
+        return None
+    region = head_region(detection)
+    return region if region[2] - region[0] >= MIN_HEAD_PX else None
+
+
+def describe(
+    rgb: np.ndarray,
+    detection: PersonDetection,
+    params: IdentityParams,
+    encoder: FaceEncoder | None = None,
+    converted: np.ndarray | None = None,
+) -> Appearance:
+    """Measure a detection in ``rgb``: its upper/lower histograms and, with ``encoder``, its
+    best face inside :func:`head_region` (not when the head box touches the image border: a cut
+    face embeds badly). ``converted`` is ``rgb`` already in the clothes'
+    colour space (to convert once per frame for several people)."""
+    shape = rgb.shape[:2]
+    (r0, r1, c0, c1), upper_mask, lower_mask = body_parts_window(
+        shape, detection.box, detection.mask, dict(detection.keypoints or {})
+    )
+    # the person's box: the same pixels as the whole image's masks
+    if converted is not None:
+        img = converted[r0:r1, c0:c1]
+    else:
+        img = convert(rgb[r0:r1, c0:c1], params.clothes.color_space)
+    upper = color_histogram(img, upper_mask, params.clothes, converted=True)
+    lower = color_histogram(img, lower_mask, params.clothes, converted=True)
+    face = face_box = None
+    region = face_region(detection, shape) if encoder is not None and params.faces else None
+    if encoder is not None and region is not None:
+        faces = encoder.detect(rgb, region)
+        if faces:
+            face, face_box = faces[0].embedding, faces[0].box
+    return Appearance(upper, lower, face, face_box)
+
+
+# -- the target's profile ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TargetProfile:
+    """The target's appearance: normalised upper/lower clothing histograms in ``color_space``
+    with ``bins``, and ``faces`` ``(k, 128)`` embeddings (k may be 0)."""
+
+    upper: np.ndarray
+    lower: np.ndarray
+    faces: np.ndarray
+    color_space: ColorSpace = "hsv"
+    bins: tuple[int, int, int] = (16, 4, 4)
+    frames: int = 0
+    """How many frames the profile was learned from."""
+
+    @property
+    def clothes(self) -> ClothesParams:
+        return ClothesParams(self.color_space, self.bins)
+
+    def face_distance(self, embedding: np.ndarray) -> float | None:
+        """Distance of a face to the target's: the median over the profile's embeddings (robust
+        to a few odd samples in either direction); None if the profile has no face."""
+        if len(self.faces) == 0:
+            return None
+        return float(np.median(face_distance(self.faces, embedding)))
+
+    def similarity(self, appearance: Appearance) -> float | None:
+        """Clothes similarity S of an appearance: the smaller of the upper and lower body's
+        (both must match; a part not seen does not count); None if neither was seen."""
+        s = [
+            histogram_intersection(h, t)
+            for h, t in ((appearance.upper, self.upper), (appearance.lower, self.lower))
+            if h is not None
+        ]
+        return min(s) if s else None
+
+    # .npz I/O ------------------------------------------------------------------------------------
+
+    def to_bytes(self) -> bytes:
+        """The profile as ``.npz`` bytes (version, histograms, faces, colour space, bins)."""
+        buf = io.BytesIO()
+        np.savez(
+            buf,
+            version=np.array(PROFILE_VERSION),
+            upper=np.asarray(self.upper, dtype=np.float64),
+            lower=np.asarray(self.lower, dtype=np.float64),
+            faces=np.asarray(self.faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+            color_space=np.array(self.color_space),
+            bins=np.asarray(self.bins, dtype=np.int64),
+            frames=np.array(self.frames),
+        )
+        return buf.getvalue()
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the profile to ``path`` atomically."""
+        return atomic_write(path, self.to_bytes())
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> TargetProfile:
+        """Read a profile written by :meth:`save`; a bad file is a one-line UserError."""
+        name = str(path)
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                fields = {k: data[k] for k in data.files}
+        except FileNotFoundError:
+            raise UserError(f"{name}: no such target profile") from None
+        except (OSError, ValueError) as err:
+            raise UserError(f"{name}: not a target profile (.npz): {err}") from None
+        missing = {"version", "upper", "lower", "faces", "color_space", "bins"} - set(fields)
+        if missing:
+            raise UserError(f"{name}: not a target profile: missing {', '.join(sorted(missing))}")
+        version = int(fields["version"])
+        if version != PROFILE_VERSION:
+            raise UserError(
+                f"{name}: version: expected {PROFILE_VERSION}, got {version} (learn it again)"
+            )
+        space = str(fields["color_space"])
+        if space not in ("hsv", "rgb", "lab"):
+            raise UserError(f"{name}: color_space: expected hsv, rgb or lab, got {space!r}")
+        bins = tuple(int(b) for b in np.ravel(fields["bins"]))
+        if len(bins) != 3 or min(bins) < 1:
+            raise UserError(f"{name}: bins: expected three positive counts, got {bins}")
+        size = int(np.prod(bins))
+        upper, lower = (np.asarray(fields[k], dtype=np.float64).ravel() for k in ("upper", "lower"))
+        for key, h in (("upper", upper), ("lower", lower)):
+            if h.size != size or not np.all(np.isfinite(h)) or np.any(h < 0):
+                raise UserError(
+                    f"{name}: {key}: expected {size} finite non-negative histogram bins"
+                )
+        faces = np.asarray(fields["faces"], dtype=np.float64)
+        if faces.ndim != 2 or faces.shape[1] != EMBEDDING_SIZE or not np.all(np.isfinite(faces)):
+            raise UserError(f"{name}: faces: expected a (k, {EMBEDDING_SIZE}) array")
+        return cls(
+            upper=upper,
+            lower=lower,
+            faces=faces,
+            color_space=space,  # type: ignore[arg-type]
+            bins=bins,  # type: ignore[arg-type]
+            frames=int(fields.get("frames", 0)),
+        )
+
+    def check_params(self, params: IdentityParams, source: str = "profile") -> None:
+        """A UserError unless the profile's histograms are in the mission's colour space/bins."""
+        want = params.clothes
+        if (self.color_space, tuple(self.bins)) != (want.color_space, tuple(want.bins)):
+            raise UserError(
+                f"{source}: histograms are {self.color_space} {list(self.bins)}, the mission's "
+                f"perception.identity wants {want.color_space} {list(want.bins)} (learn it again)"
+            )
+
+
+def learn_profile(
+    appearances: Sequence[Appearance],
+    params: IdentityParams,
+    max_faces: int = MAX_PROFILE_FACES,
+) -> TargetProfile:
+    """The profile of a person from appearances of them (one per frame): the mean of the
+    normalised histograms (renormalised) and up to ``max_faces`` face embeddings spread evenly
+    over the samples. ValueError if no appearance has both clothing parts."""
+    uppers = [a.upper for a in appearances if a.upper is not None]
+    lowers = [a.lower for a in appearances if a.lower is not None]
+    if not uppers or not lowers:
+        raise ValueError("no appearance shows both the upper and the lower body")
+
+    def mean(hs: list[np.ndarray]) -> np.ndarray:
+        m = np.mean(hs, axis=0)
+        return m / m.sum()
+
+    faces = [a.face for a in appearances if a.face is not None]
+    if len(faces) > max_faces:
+        keep = np.linspace(0, len(faces) - 1, max_faces).round().astype(int)
+        faces = [faces[i] for i in keep]
+    return TargetProfile(
+        upper=mean(uppers),
+        lower=mean(lowers),
+        faces=np.array(faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+        color_space=params.clothes.color_space,
+        bins=params.clothes.bins,
+        frames=len(appearances),
+    )
+
+
+# -- per-track decisions -------------------------------------------------------------------------
+
+
+class Decision(enum.Enum):
+    """What Algorithm 2 concludes about a track."""
+
+    TARGET = "target"
+    NOT_TARGET = "not_target"
+    UNKNOWN = "unknown"
+
+
+@dataclass(frozen=True)
+class TrackIdentity:
+    """The evidence gathered about one track and the decision it supports."""
+
+    track_id: int
+    decision: Decision
+    confidence: float
+    """Heuristic 0..1: faces ≥ 0.8, clothes ≤ 0.8, unknown 0."""
+    basis: str
+    """What decided: ``face``, ``clothes``, ``no_legs`` or ``nothing``."""
+    face_distance: float | None
+    """Median face distance to the profile over the track's face samples (None: no face yet)."""
+    best_face_distance: float | None
+    clothes_similarity: float | None
+    """Mean clothes similarity S over the track's observations (None: never measured)."""
+    face_samples: int
+    clothes_samples: int
+    observations: int
+    legs_seen: int
+    last_seen: float
+    face_box: Box | None = None
+    """Where the face was found, when a face was folded in at this identity's time (inline: in
+    this observation's frame; with a worker: in the frame the search was submitted from)."""
+
+
+@dataclass
+class _Evidence:
+    face_distances: list[float] = field(default_factory=list)
+    last_face: float = -math.inf
+    """Stamp of the frame of the newest face sample."""
+    clothes: list[float] = field(default_factory=list)
+    observations: int = 0
+    legs_seen: int = 0
+    last_seen: float = -math.inf
+    last_search: float = -math.inf
+    """Stamp of the frame of the newest face search (made or submitted)."""
+    face_misses: int = 0
+    """Face searches in a row that found no face."""
+    last_clothes: float = -math.inf
+    """Stamp of the frame of the newest clothes measurement."""
+    face_box: Box | None = None
+    face_box_at: float = math.nan
+    """When ``face_box`` was folded in: identities made then report it."""
+    job: tuple[int, int] | None = None
+    """The face search of this track out at the worker, if any."""
+
+
+@dataclass(frozen=True)
+class _Job:
+    """A face search out at the worker."""
+
+    job: tuple[int, int]
+    track_id: int
+    evidence: _Evidence
+    stamp: float
+    """Stamp of the frame the head was cropped from."""
+    due: float
+    """Deterministic timing: folded in at the first observation stamped this or later."""
+
+
+@dataclass
+class FaceSearchStats:
+    """What the identifier did about faces and clothes (counters since it was made)."""
+
+    inline: int = 0
+    """Searches run inline (no worker)."""
+    submitted: int = 0
+    """Searches submitted to the worker."""
+    refused: int = 0
+    """Searches the worker refused (busy; tried again on a later frame)."""
+    deferred: int = 0
+    """Searches due but not submitted because ``max_in_flight`` were out (deterministic)."""
+    folded: int = 0
+    """Worker results folded into a track's evidence."""
+    discarded: int = 0
+    """Worker results whose track was deleted meanwhile."""
+    backed_off: int = 0
+    """Searches skipped because the track's searches kept missing (``face_miss_limit``)."""
+    waited_s: float = 0.0
+    """Wall time spent waiting for the worker (deterministic timing), seconds."""
+    clothes_measured: int = 0
+    """Clothing histogram pairs measured (one per seen track and frame when due)."""
+    clothes_skipped: int = 0
+    """Clothes measurements skipped because the track was settled (``clothes_recheck_s``)."""
+
+
+class TargetIdentifier:
+    """Algorithm 2 over time: feed each track's observations, ask which track is the target.
+
+    ``observe(track_id, t, has_legs, detection, rgb)`` adds one observation of a track (the
+    detection associated with it in this frame, or None when the camera did not see it) and
+    returns the track's current :class:`TrackIdentity`; :meth:`observe_frame` does the same for
+    all the tracks one frame saw (converting the frame's colours once, and giving the worker's
+    few slots to the tracks searched longest ago). A track is a candidate only once the leg
+    detector has confirmed it (``has_legs``) at least once. Faces are searched as the module
+    docstring says (settled tracks every ``face_recheck_s``, missing ones backed off); clothes
+    are measured every time.
+
+    ``worker`` (a :class:`~pfctl.core.perception.face_worker.FaceWorker`): faces are searched there,
+    with ``params.face_timing``; without one they are searched inline with ``encoder`` (default: a
+    :class:`~pfctl.core.perception.faces.FaceEncoder` of ``params.face``). :meth:`close` closes the
+    worker.
+    """
+
+    def __init__(
+        self,
+        profile: TargetProfile,
+        params: IdentityParams | None = None,
+        encoder: FaceEncoder | None = None,
+        *,
+        worker: FaceWorker | None = None,
+    ) -> None:
+        self.params = params or IdentityParams(clothes=profile.clothes)
+        profile.check_params(self.params)
+        if self.params.face_timing not in ("deterministic", "realtime"):
+            raise ValueError(f"face_timing: unknown {self.params.face_timing!r}")
+        self.profile = profile
+        use_faces = self.params.faces and len(profile.faces) > 0
+        self.worker = worker if use_faces else None
+        self.encoder = (
+            (encoder or FaceEncoder(self.params.face)) if use_faces and worker is None else None
+        )
+        self.face_stats = FaceSearchStats()
+        self._tracks: dict[int, _Evidence] = {}
+        self._latest: dict[int, TrackIdentity] = {}
+        self._jobs: dict[tuple[int, int], _Job] = {}
+        """Searches out at the worker, in the order submitted."""
+        self._arrived: dict[tuple[int, int], FaceResult] = {}
+        self._next_job = 0
+        self._key = next(_IDENTIFIERS)
+        """Job keys are ``(key, n)``: several identifiers may share one worker."""
+        self._given_worker = worker
+
+    @property
+    def searches_faces(self) -> bool:
+        """Whether faces are searched at all (inline or in a worker)."""
+        return self.encoder is not None or self.worker is not None
+
+    @property
+    def pending(self) -> int:
+        """Face searches out at the worker (submitted, not folded in yet)."""
+        return len(self._jobs)
+
+    def observe(
+        self,
+        track_id: int,
+        t: float,
+        has_legs: bool,
+        detection: PersonDetection | None,
+        rgb: np.ndarray | None,
+        appearance: Appearance | None = None,
+    ) -> TrackIdentity:
+        """Add one observation of ``track_id`` at time ``t``; the updated identity. Pass
+        ``appearance`` when it is already measured (else it is measured from ``rgb``; its face
+        is then searched only when due)."""
+        if appearance is not None and detection is not None:
+            self.update(t)
+            ev = self._observed(track_id, t, has_legs)
+            self._add_clothes(ev, appearance)
+            if appearance.face is not None and self.searches_faces:
+                self._fold_face(ev, t, appearance.face, appearance.face_box, t)
+            return self._identify(track_id, ev, t)
+        return self.observe_frame(t, rgb, [(track_id, has_legs, detection)])[0]
+
+    def observe_frame(
+        self,
+        t: float,
+        rgb: np.ndarray | None,
+        sightings: Sequence[tuple[int, bool, PersonDetection | None]],
+    ) -> list[TrackIdentity]:
+        """Add one observation per ``(track_id, has_legs, detection)`` of the frame ``rgb``
+        stamped ``t`` (detection None: the camera did not see that track); the updated
+        identities, in order. Face searches that are due go to the tracks searched longest ago
+        first (they matter when a worker has few slots)."""
+        self.update(t)
+        seen: list[tuple[int, _Evidence, PersonDetection | None]] = []
+        for track_id, has_legs, _ in sightings:
+            seen.append((track_id, self._observed(track_id, t, has_legs), None))
+        if rgb is not None:
+            converted = None
+            for k, (track_id, ev, _) in enumerate(seen):
+                detection = sightings[k][2]
+                if detection is None:
+                    continue
+                seen[k] = (track_id, ev, detection)
+                if not self._clothes_due(ev, t):
+                    self.face_stats.clothes_skipped += 1
+                    continue
+                if converted is None:
+                    converted = convert(rgb, self.params.clothes.color_space)
+                self._add_clothes(ev, describe(rgb, detection, self.params, None, converted))
+                ev.last_clothes = t
+                self.face_stats.clothes_measured += 1
+            wanted = [
+                (ev.last_search, k)
+                for k, (_, ev, detection) in enumerate(seen)
+                if detection is not None and self._face_due(ev, t)
+            ]
+            for _, k in sorted(wanted):
+                track_id, ev, detection = seen[k]
+                assert detection is not None
+                region = face_region(detection, rgb.shape)
+                if region is not None:
+                    self._search(track_id, ev, t, rgb, region)
+        return [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
+
+    def update(self, t: float) -> None:
+        """Fold in the worker's results that count at ``t`` (``face_timing``); nothing without
+        a worker. Called by every observation; call it when a frame shows nobody, too."""
+        if self.worker is None or not self._jobs:
+            return
+        for result in self.worker.poll():
+            if result.job in self._jobs:  # not another identifier's
+                self._arrived[result.job] = result  # type: ignore[index]
+        if self.params.face_timing == "deterministic":
+            due = [j for j in self._jobs.values() if j.due <= t + STAMP_EPS]
+            for job in due:
+                result = self._arrived.pop(job.job, None)
+                if result is None:
+                    t0 = time.perf_counter()
+                    result = self.worker.wait(job.job)
+                    self.face_stats.waited_s += time.perf_counter() - t0
+                self._finish(job, result, t)
+        else:
+            arrived, self._arrived = self._arrived, {}
+            for job_id, result in arrived.items():
+                job = self._jobs.get(job_id)
+                if job is not None:
+                    self._finish(job, result, t)
+
+    def close(self) -> None:
+        """Close the face worker (if one was given); safe to call twice."""
+        if self._given_worker is not None:
+            self._given_worker.close()
+        self._jobs.clear()
+        self._arrived.clear()
+
+    # -- internals ----------------------------------------------------------------------------
+
+    def _observed(self, track_id: int, t: float, has_legs: bool) -> _Evidence:
+        ev = self._tracks.setdefault(track_id, _Evidence())
+        ev.observations += 1
+        ev.last_seen = t
+        ev.legs_seen += bool(has_legs)
+        return ev
+
+    def _add_clothes(self, ev: _Evidence, appearance: Appearance) -> None:
+        s = self.profile.similarity(appearance)
+        if s is not None:
+            ev.clothes.append(s)
+
+    def _clothes_due(self, ev: _Evidence, t: float) -> bool:
+        """Whether the track's clothes (Algorithm 2's histogram intersection) should be
+        measured in the frame stamped ``t``: always until its clothes evidence is settled, then
+        every ``clothes_recheck_s`` (module docstring)."""
+        p = self.params
+        if len(ev.clothes) < p.clothes_settled or t - ev.last_clothes >= (
+            p.clothes_recheck_s - STAMP_EPS
+        ):
+            return True
+        if ev.face_distances:  # a face decides; clothes do not enter the decision
+            return False
+        return abs(float(np.mean(ev.clothes)) - p.clothes_similarity) < p.clothes_margin
+
+    def _face_due(self, ev: _Evidence, t: float) -> bool:
+        """Whether the track's face should be searched in the frame stamped ``t``."""
+        p = self.params
+        if not self.searches_faces or ev.job is not None:
+            return False
+        settled = len(ev.face_distances) >= p.face_settled
+        if settled and t - ev.last_face < p.face_recheck_s - STAMP_EPS:
+            return False
+        if ev.face_misses >= p.face_miss_limit and (
+            t - ev.last_search < p.face_miss_backoff_s - STAMP_EPS
+        ):
+            self.face_stats.backed_off += 1
+            return False
+        return True
+
+    def _search(self, track_id: int, ev: _Evidence, t: float, rgb: np.ndarray, region: Box) -> None:
+        """Search ``region`` for the track's face: inline now, or submitted to the worker."""
+        if self.worker is None:
+            assert self.encoder is not None
+            ev.last_search = t
+            self.face_stats.inline += 1
+            self._fold_faces(ev, t, self.encoder.detect(rgb, region), t)
+            return
+        if self.params.face_timing == "deterministic" and len(self._jobs) >= (
+            self.worker.max_in_flight
+        ):
+            self.face_stats.deferred += 1
+            return
+        job = (self._key, self._next_job)
+        if not self.worker.submit(job, rgb, region):
+            self.face_stats.refused += 1
+            if self.params.face_timing == "realtime":
+                return  # busy: the track is tried again on a later frame
+            # deterministic: only someone else's jobs can fill the worker; wait for a slot
+            self.worker.wait_slot()
+            if not self.worker.submit(job, rgb, region):  # pragma: no cover - cannot happen
+                raise RuntimeError("face worker refused a job with a free slot")
+        self._next_job += 1
+        self.face_stats.submitted += 1
+        ev.last_search = t
+        ev.job = job
+        due = t + self.params.face_latency_s
+        self._jobs[job] = _Job(job, track_id, ev, t, due)
+
+    def _finish(self, job: _Job, result: FaceResult, now: float) -> None:
+        """A worker result: into its track's evidence, unless the track was deleted."""
+        del self._jobs[job.job]
+        job.evidence.job = None
+        if self._tracks.get(job.track_id) is not job.evidence:
+            self.face_stats.discarded += 1
+            return
+        self.face_stats.folded += 1
+        self._fold_faces(job.evidence, job.stamp, result.faces, now)
+        self._identify(job.track_id, job.evidence, now)
+
+    def _fold_faces(self, ev: _Evidence, stamp: float, faces: Sequence[Face], now: float) -> None:
+        """The outcome of one face search of the frame stamped ``stamp`` (best face first)."""
+        if faces:
+            self._fold_face(ev, stamp, faces[0].embedding, faces[0].box, now)
+        else:
+            ev.face_misses += 1
+
+    def _fold_face(
+        self, ev: _Evidence, stamp: float, embedding: np.ndarray, box: Box | None, now: float
+    ) -> None:
+        d = self.profile.face_distance(embedding)
+        if d is None:
+            return
+        ev.face_distances.append(d)
+        ev.last_face = max(ev.last_face, stamp)
+        ev.face_misses = 0
+        ev.face_box, ev.face_box_at = box, now
+
+    def _identify(self, track_id: int, ev: _Evidence, now: float) -> TrackIdentity:
+        """The track's identity now (and remembered as its latest)."""
+        box = ev.face_box if ev.face_box_at == now else None
+        identity = self._decide(track_id, ev, box)
+        self._latest[track_id] = identity
+        return identity
+
+    def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
+        p = self.params
+        face_d = float(np.median(ev.face_distances)) if ev.face_distances else None
+        best = min(ev.face_distances) if ev.face_distances else None
+        clothes = float(np.mean(ev.clothes)) if ev.clothes else None
+        if ev.legs_seen == 0:
+            decision, conf, basis = Decision.UNKNOWN, 0.0, "no_legs"
+        elif face_d is not None:
+            margin = min(1.0, abs(face_d - p.face_distance) / 0.2)
+            decision = Decision.TARGET if face_d < p.face_distance else Decision.NOT_TARGET
+            conf, basis = 0.8 + 0.2 * margin, "face"
+        elif clothes is not None:
+            margin = min(1.0, abs(clothes - p.clothes_similarity) / 0.3)
+            ok = clothes >= p.clothes_similarity
+            decision = Decision.TARGET if ok else Decision.NOT_TARGET
+            conf, basis = 0.5 + 0.3 * margin, "clothes"
+        else:
+            decision, conf, basis = Decision.UNKNOWN, 0.0, "nothing"
+        return TrackIdentity(
+            track_id=track_id,
+            decision=decision,
+            confidence=conf,
+            basis=basis,
+            face_distance=face_d,
+            best_face_distance=best,
+            clothes_similarity=clothes,
+            face_samples=len(ev.face_distances),
+            clothes_samples=len(ev.clothes),
+            observations=ev.observations,
+            legs_seen=ev.legs_seen,
+            last_seen=ev.last_seen,
+            face_box=face_box,
+        )
+
+    def identity(self, track_id: int) -> TrackIdentity | None:
+        """The latest identity of a track (None if never observed or forgotten)."""
+        return self._latest.get(track_id)
+
+    def identities(self) -> dict[int, TrackIdentity]:
+        """The latest identity of every known track."""
+        return dict(self._latest)
+
+    def target_track(self) -> int | None:
+        """The track that is the target: among tracks decided TARGET, a face-confirmed one before
+        a clothes-only one, then the higher confidence, then the most recently seen; None if no
+        track is decided TARGET."""
+        best: tuple[tuple[int, float, float], int] | None = None
+        for tid, ident in self._latest.items():
+            if ident.decision is not Decision.TARGET:
+                continue
+            key = (int(ident.basis == "face"), ident.confidence, ident.last_seen)
+            if best is None or key > best[0]:
+                best = (key, tid)
+        return None if best is None else best[1]
+
+    def forget(self, track_id: int) -> None:
+        """Drop a track's evidence (the tracker deleted it)."""
+        self._tracks.pop(track_id, None)
+        self._latest.pop(track_id, None)
+
+
+__all__ = [
+    "MAX_PROFILE_FACES",
+    "PROFILE_VERSION",
+    "Appearance",
+    "Decision",
+    "FaceSearchStats",
+    "FaceTiming",
+    "IdentityParams",
+    "TargetIdentifier",
+    "TargetProfile",
+    "TrackIdentity",
+    "describe",
+    "face_region",
+    "head_region",
+    "learn_profile",
+]

@@ -1,0 +1,239 @@
+"""Leg detection in the 2-D base laser and legs paired into person candidates (§II-E).
+
+The paper finds people around the robot from its base laser: the scan is cut into segments,
+each segment is described by geometric features and a random forest says whether it is a leg;
+legs close together are one person. Here:
+
+1. :func:`~pfctl.core.perception.legs.features.segment_scan` cuts the scan at jumps wider than
+   ``jump_distance`` and at beams without return (Arras, Mozos, Burgard 2007, §III-A);
+2. segments with at least ``min_points`` returns whose centroid is within ``max_range`` are
+   described by :func:`~pfctl.core.perception.legs.features.segment_features` (Arras et al. 2007,
+   §IV, plus the distance from the laser);
+3. the forest (:class:`~pfctl.core.perception.legs.model.LegModel`, trained by ``pfctl legs train``)
+gives
+   P(leg), averaged over the last ``history_scans`` scans of the segment's track when that is
+   more than 1 (:class:`~pfctl.core.perception.legs.evidence.LegEvidence`); segments with P ≥
+   ``probability`` are legs;
+4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
+   (greedy matching by distance), into person candidates at the midpoint; a leg left alone
+   with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
+   its confidence halved.
+
+Legs and people are reported in the map frame (through ``scan.pose``). A leg's position is its
+segment's centroid moved :data:`LEG_DEPTH` farther along the beam: the laser sees the front of
+the leg, its axis is behind.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from pfctl.core.perception.legs.evidence import LegEvidence
+from pfctl.core.perception.legs.features import (
+    FEATURE_NAMES,
+    Segments,
+    segment_features,
+    segment_scan,
+)
+from pfctl.core.perception.legs.model import LegModel, read_leg_model
+from pfctl.core.robot import LaserScan
+
+#: From a leg's visible surface to its axis along the beam, metres (≈ 0.75 × a 6 cm leg radius:
+#: the centroid of the visible half of a circle sampled evenly across).
+LEG_DEPTH = 0.045
+#: A candidate from one leg gets this fraction of the leg's probability.
+SINGLE_LEG_FACTOR = 0.5
+_DISTANCE = FEATURE_NAMES.index("distance")
+
+
+@dataclass(frozen=True)
+class LegParams:
+    """Detector parameters (the mission's ``perception.legs``)."""
+
+    probability: float = 0.5
+    """P(leg) at or above which a segment is a leg."""
+    jump_distance: float = 0.13
+    """Neighbouring returns farther apart than this start a new segment, metres."""
+    min_points: int = 3
+    """Segments with fewer returns are not classified."""
+    max_range: float = 6.0
+    """Segments whose centroid is farther from the laser than this are not classified, metres."""
+    pair_distance: float = 0.45
+    """Two legs closer than this are one person, metres."""
+    single_leg_probability: float = 0.8
+    """A leg without a partner is still a person candidate when its P(leg) is at least this."""
+    history_scans: int = 10
+    """P(leg) is the mean over this many scans of the segment's track (1: this scan alone;
+    :class:`~pfctl.core.perception.legs.evidence.LegEvidence`)."""
+
+
+@dataclass(frozen=True)
+class Leg:
+    """A detected leg in the map frame and its P(leg)."""
+
+    x: float
+    y: float
+    probability: float
+
+
+@dataclass(frozen=True)
+class PersonCandidate:
+    """A person seen by the laser: the midpoint of two legs (or one leg), map frame."""
+
+    x: float
+    y: float
+    probability: float
+    legs: tuple[Leg, ...]
+
+
+@dataclass(frozen=True)
+class LegDetections:
+    """The legs and person candidates of one scan."""
+
+    stamp: float
+    legs: tuple[Leg, ...]
+    people: tuple[PersonCandidate, ...]
+
+
+@dataclass(frozen=True)
+class ClassifiedSegments:
+    """Every segment of a scan with what the detector made of it (for evaluation and plots).
+
+    ``classified`` marks segments that passed ``min_points`` and ``max_range``; ``probability``
+    is P(leg) for those and 0 for the others; ``features`` has a row per segment (laser frame).
+    """
+
+    segments: Segments
+    features: np.ndarray
+    classified: np.ndarray
+    probability: np.ndarray
+
+
+def shipped_model_path() -> Path:
+    """The model shipped with pfctl (``pfctl/data/legs_model.npz``)."""
+    return Path(str(resources.files("pfctl") / "data" / "legs_model.npz"))
+
+
+def load_leg_model(path: Path | None = None) -> LegModel:
+    """Load a leg model (``None``: the shipped one); one-line :class:`UserError` if unusable."""
+    return read_leg_model(shipped_model_path() if path is None else Path(path), FEATURE_NAMES)
+
+
+def describe_segments(
+    scan: LaserScan, params: LegParams
+) -> tuple[Segments, np.ndarray, np.ndarray]:
+    """Segments of the scan, their features ``(k, f)`` and which of them the detector classifies
+    (at least ``min_points`` returns, centroid within ``max_range``)."""
+    segs = segment_scan(
+        scan.ranges,
+        scan.angle_min,
+        scan.angle_increment,
+        scan.range_min,
+        scan.range_max,
+        params.jump_distance,
+    )
+    feats = segment_features(segs)
+    ok = (segs.count >= params.min_points) & (feats[:, _DISTANCE] <= params.max_range)
+    return segs, feats, ok
+
+
+def classify_segments(scan: LaserScan, model: LegModel, params: LegParams) -> ClassifiedSegments:
+    """Segment the scan, compute the features and P(leg) of every segment that qualifies."""
+    segs, feats, ok = describe_segments(scan, params)
+    prob = np.zeros(len(segs))
+    if ok.any():
+        prob[ok] = model.predict_proba(feats[ok])
+    return ClassifiedSegments(segs, feats, ok, prob)
+
+
+def pair_legs(xy: np.ndarray, probability: np.ndarray, params: LegParams) -> list[tuple[int, ...]]:
+    """Group legs into people: pairs closer than ``pair_distance``, closest first (greedy
+    matching by distance), then each unmatched leg with P ≥ ``single_leg_probability`` alone.
+    Returns tuples of leg indices."""
+    n = len(xy)
+    groups: list[tuple[int, ...]] = []
+    used = np.zeros(n, dtype=bool)
+    if n >= 2:
+        d = np.hypot(xy[:, None, 0] - xy[None, :, 0], xy[:, None, 1] - xy[None, :, 1])
+        i, j = np.triu_indices(n, 1)
+        close = d[i, j] < params.pair_distance
+        i, j, dist = i[close], j[close], d[i, j][close]
+        for k in np.argsort(dist, kind="stable"):
+            a, b = int(i[k]), int(j[k])
+            if not used[a] and not used[b]:
+                used[a] = used[b] = True
+                groups.append((a, b))
+    for a in range(n):
+        if not used[a] and probability[a] >= params.single_leg_probability:
+            groups.append((a,))
+    return groups
+
+
+class LegDetector:
+    """Laser leg detector (§II-E): ``detect(scan)`` → legs and person candidates, map frame.
+
+    With ``history_scans`` > 1 it remembers the segments of the previous scans (one detector per
+    laser; :meth:`reset` between unrelated sequences)."""
+
+    def __init__(self, model: LegModel, params: LegParams | None = None) -> None:
+        self.model = model
+        self.params = params or LegParams()
+        self.evidence = (
+            LegEvidence(self.params.history_scans) if self.params.history_scans > 1 else None
+        )
+
+    def reset(self) -> None:
+        """Forget the segments of earlier scans."""
+        if self.evidence is not None:
+            self.evidence.reset()
+
+    def detect(self, scan: LaserScan) -> LegDetections:
+        """Legs (P ≥ ``probability``) and the people they make in one scan."""
+        c = classify_segments(scan, self.model, self.params)
+        if self.evidence is not None:
+            seen = np.flatnonzero(c.classified)
+            where = scan.pose.transform(c.segments.centroids()[seen])
+            c.probability[seen] = self.evidence.update(where, c.probability[seen])
+        is_leg = c.classified & (c.probability >= self.params.probability)
+        idx = np.flatnonzero(is_leg)
+        if len(idx) == 0:
+            return LegDetections(scan.stamp, (), ())
+        local = c.segments.centroids()[idx]
+        rng = np.maximum(np.hypot(*local.T), 1e-9)
+        local = local * ((rng + LEG_DEPTH) / rng)[:, None]
+        world = scan.pose.transform(local)
+        prob = c.probability[idx]
+        legs = tuple(
+            Leg(float(x), float(y), float(p)) for (x, y), p in zip(world, prob, strict=True)
+        )
+        people = []
+        for group in pair_legs(world, prob, self.params):
+            pts = world[list(group)]
+            p = float(prob[list(group)].mean())
+            if len(group) == 1:
+                p *= SINGLE_LEG_FACTOR
+            mid = pts.mean(axis=0)
+            people.append(
+                PersonCandidate(float(mid[0]), float(mid[1]), p, tuple(legs[g] for g in group))
+            )
+        return LegDetections(scan.stamp, legs, tuple(people))
+
+
+__all__ = [
+    "LEG_DEPTH",
+    "ClassifiedSegments",
+    "Leg",
+    "LegDetections",
+    "LegDetector",
+    "LegParams",
+    "PersonCandidate",
+    "classify_segments",
+    "describe_segments",
+    "load_leg_model",
+    "pair_legs",
+    "shipped_model_path",
+]

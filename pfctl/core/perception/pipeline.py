@@ -1,0 +1,161 @@
+"""The robot's sense of people (§II-E): laser legs and camera people → tracks → who is the target.
+
+One :class:`Perception` holds the parts of the paper's perception and runs them per sensor
+message, in the order the follower needs them:
+
+- a **scan** → :class:`~pfctl.core.perception.legs.detector.LegDetector` (segments, Arras et
+  al. features, random forest, leg pairs) → person candidates →
+  :class:`~pfctl.core.perception.tracking.MultiPersonTracker` (``laser`` detections, the scan's
+  field of view with its returns as occluders);
+- an **RGB-D frame** → a :class:`~pfctl.core.perception.vision.PersonDetector` → 3-D people →
+  the same tracker (``camera`` detections, the camera's floor wedge) → Algorithm 2
+  (:class:`~pfctl.core.perception.identity.identifier.TargetIdentifier`, one call per frame) for
+  every track the camera saw, with "has legs" meaning the laser has associated leg detections
+  with that track (with a face worker, its results are folded in there too); and, when a
+  :class:`~pfctl.core.perception.belief.HumanBelief` is given, the Eq. 4 update of the camera's
+  view.
+
+The target is the track Algorithm 2 names, as long as the tracker still has it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from pfctl.core.episode import TrackRow
+from pfctl.core.perception.belief import HumanBelief
+from pfctl.core.perception.identity.identifier import TargetIdentifier, TrackIdentity
+from pfctl.core.perception.legs.detector import LegDetections, LegDetector
+from pfctl.core.perception.tracking import (
+    Detection,
+    FieldOfView,
+    MultiPersonTracker,
+    Track,
+    TrackStatus,
+)
+from pfctl.core.perception.vision import PersonDetection, PersonDetector
+from pfctl.core.robot import LaserScan, Observation, RgbdFrame
+
+
+@dataclass(frozen=True)
+class CameraSighting:
+    """A person the camera saw in one frame, the track it was associated with (None: no
+    track) and, with an identifier, that track's identity after this frame."""
+
+    detection: PersonDetection
+    track_id: int | None
+    identity: TrackIdentity | None
+
+
+class Perception:
+    """Legs + vision → tracking → identification (+ belief), fed one sensor message at a time."""
+
+    def __init__(
+        self,
+        legs: LegDetector,
+        tracker: MultiPersonTracker,
+        *,
+        detector: PersonDetector | None = None,
+        identifier: TargetIdentifier | None = None,
+        belief: HumanBelief | None = None,
+        camera_range: tuple[float, float] = (0.4, 8.0),
+    ) -> None:
+        """``detector`` None: the camera is not used; ``identifier`` None: no target is
+        identified; ``camera_range``: the depth interval (m) in which the camera sees people."""
+        self.legs = legs
+        self.tracker = tracker
+        self.detector = detector
+        self.identifier = identifier
+        self.belief = belief
+        self.camera_range = camera_range
+        self._leg_tracks: set[int] = set()
+        self.last_legs: LegDetections | None = None
+        self.last_sightings: tuple[CameraSighting, ...] = ()
+
+    def on_scan(self, scan: LaserScan) -> LegDetections:
+        """Detect legs in ``scan`` and update the tracks with the person candidates."""
+        found = self.legs.detect(scan)
+        detections = [Detection(p.x, p.y, p.probability) for p in found.people]
+        ids = self.tracker.update("laser", detections, FieldOfView.from_scan(scan), scan.stamp)
+        self._leg_tracks.update(i for i in ids if i is not None)
+        self._forget_deleted()
+        self.last_legs = found
+        return found
+
+    def on_frame(self, frame: RgbdFrame) -> tuple[CameraSighting, ...]:
+        """Detect people in ``frame``, update the tracks, identify them and the belief."""
+        if self.detector is None:
+            return ()
+        people = self.detector.detect(frame)
+        fov = FieldOfView.from_frame(frame, self.camera_range[1], self.camera_range[0])
+        detections = [Detection(d.position[0], d.position[1], d.score) for d in people]
+        ids = self.tracker.update("camera", detections, fov, frame.stamp)
+        self._forget_deleted()
+        identities: dict[int, TrackIdentity] = {}
+        if self.identifier is not None:
+            seen = [
+                (track_id, track_id in self._leg_tracks, person)
+                for person, track_id in zip(people, ids, strict=True)
+                if track_id is not None
+            ]
+            found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen)
+            identities = {s[0]: identity for s, identity in zip(seen, found, strict=True)}
+        sightings = [
+            CameraSighting(person, track_id, None if track_id is None else identities.get(track_id))
+            for person, track_id in zip(people, ids, strict=True)
+        ]
+        if self.belief is not None:
+            self.belief.update(fov, [d.position[:2] for d in people], frame.stamp)
+        self.last_sightings = tuple(sightings)
+        return self.last_sightings
+
+    def on_observation(self, observation: Observation) -> None:
+        """Feed what one :class:`~pfctl.core.robot.Observation` brings (scan, frame or both)."""
+        if observation.scan is not None:
+            self.on_scan(observation.scan)
+        if observation.rgbd is not None:
+            self.on_frame(observation.rgbd)
+
+    def _forget_deleted(self) -> None:
+        alive = {t.id for t in self.tracker.tracks()}
+        self._leg_tracks &= alive
+        if self.identifier is not None:
+            for gone in set(self.identifier.identities()) - alive:
+                self.identifier.forget(gone)
+
+    def tracks(self, *, confirmed_only: bool = True) -> list[Track]:
+        """The current tracks (by default the confirmed and coasting ones)."""
+        return self.tracker.tracks(confirmed_only=confirmed_only)
+
+    def target(self) -> Track | None:
+        """The target's track: the one Algorithm 2 names, if the tracker still has it."""
+        if self.identifier is None:
+            return None
+        track_id = self.identifier.target_track()
+        return None if track_id is None else self.tracker.track(track_id)
+
+    def seen_track_rows(self, stamp: float) -> list[TrackRow]:
+        """One :func:`track_rows` row per confirmed track seen now (coasting tracks, which are
+        extrapolations, are left out), stamped ``stamp``: what ``pfctl replay`` writes after a
+        scan and what the follower logs after each tick with a scan."""
+        seen = [t for t in self.tracks() if t.status is TrackStatus.CONFIRMED]
+        target = self.target()
+        return track_rows(stamp, seen, target and target.id)
+
+    def has_legs(self, track_id: int) -> bool:
+        """Whether the laser has associated leg detections with ``track_id``."""
+        return track_id in self._leg_tracks
+
+    def close(self) -> None:
+        """Release what the perception holds (the identifier's face worker); safe to call twice."""
+        if self.identifier is not None:
+            self.identifier.close()
+
+
+def track_rows(stamp: float, tracks: Sequence[Track], target_id: int | None) -> list[TrackRow]:
+    """One ``(t, track_id, x, y, vx, vy, confidence, is_target)`` row per track."""
+    return [(stamp, t.id, t.x, t.y, t.vx, t.vy, t.confidence, t.id == target_id) for t in tracks]
+
+
+__all__ = ["CameraSighting", "Perception", "track_rows"]

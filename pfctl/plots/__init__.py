@@ -1,0 +1,1 @@
+"""Every figure: follow, search, prediction, map and behavior-tree drawings (DESIGN.md)."""

@@ -1,0 +1,162 @@
+"""Navigator with a kinematic omnidirectional robot in the shipped house."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import shapely
+
+from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.walls import wall_footprint
+from pfctl.core.robot import NavStatus, Pose2D, Twist2D
+from pfctl.mission import Mission
+
+DT = 0.1
+
+
+def _navigator(mission: Mission, planner: GridPlanner) -> Navigator:
+    return Navigator(planner, mission.robot.max_linear_speed, mission.robot.max_angular_speed)
+
+
+def _move(pose: Pose2D, cmd: Twist2D, dt: float) -> Pose2D:
+    """A perfect omnidirectional base: integrate the robot-frame twist."""
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    return Pose2D(
+        pose.x + (c * cmd.vx - s * cmd.vy) * dt,
+        pose.y + (s * cmd.vx + c * cmd.vy) * dt,
+        pose.theta + cmd.wz * dt,
+    )
+
+
+def _drive(nav: Navigator, pose: Pose2D, seconds: float, obstacles=None):
+    poses, cmds = [pose], []
+    for _ in range(int(seconds / DT)):
+        pts = obstacles(pose) if obstacles else None
+        cmd = nav.update(pose, DT, pts)
+        cmds.append(cmd)
+        pose = _move(pose, cmd, DT)
+        poses.append(pose)
+        if nav.status is not NavStatus.ACTIVE:
+            break
+    return poses, cmds
+
+
+def test_reaches_a_goal_in_another_room_within_limits(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    nav = _navigator(mission, planner)
+    start = Pose2D(1.0, 3.3, 0.0)
+    goal = Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office, two doors
+    nav.start(goal, start)
+    assert nav.status is NavStatus.ACTIVE
+    poses, cmds = _drive(nav, start, 200.0)
+    assert nav.status is NavStatus.SUCCEEDED
+    end = poses[-1]
+    assert end.distance_to(goal) <= nav.goal_tolerance
+    assert abs((end.theta - goal.theta + math.pi) % (2 * math.pi) - math.pi) <= nav.yaw_tolerance
+    lin = np.array([math.hypot(c.vx, c.vy) for c in cmds])
+    ang = np.array([abs(c.wz) for c in cmds])
+    assert lin.max() <= mission.robot.max_linear_speed + 1e-9
+    assert ang.max() <= mission.robot.max_angular_speed + 1e-9
+    assert lin.max() > 0.9 * mission.robot.max_linear_speed  # it really uses the speed
+    walls = wall_footprint(mission.layout(), mission.map.wall_thickness)
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert shapely.distance(walls, shapely.points(xy)).min() > mission.robot.radius - 0.03
+    assert nav.update(end, DT) == Twist2D()  # done: stands still
+
+
+def test_goal_in_a_wall_is_aborted_at_once(mission: Mission, planner: GridPlanner) -> None:
+    nav = _navigator(mission, planner)
+    nav.start(Pose2D(5.0, 3.0), Pose2D(1.0, 3.3))
+    assert nav.status is NavStatus.ABORTED
+    assert "obstacle" in nav.reason
+    assert nav.update(Pose2D(1.0, 3.3), DT) == Twist2D()
+
+
+def test_replans_around_a_blocker(mission: Mission, planner: GridPlanner) -> None:
+    """A person stands in the hall on the straight path; the laser sees its legs."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 5.0), Pose2D(8.0, 5.0)
+    blocker = np.array([6.0, 5.0])
+    ring = blocker + 0.2 * np.column_stack(
+        (np.cos(np.linspace(0, 2 * np.pi, 24)), np.sin(np.linspace(0, 2 * np.pi, 24)))
+    )
+    nav.start(goal, start)
+    first = nav.path.copy()
+    # the first plan goes straight through the person
+    assert np.abs(first[:, 1] - 5.0).max() < 0.3
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        near = np.linalg.norm(ring - (pose.x, pose.y), axis=1) < 4.0
+        return ring[near]
+
+    poses, _ = _drive(nav, start, 120.0, seen)
+    assert nav.status is NavStatus.SUCCEEDED
+    assert nav.total_replans >= 1
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert np.linalg.norm(xy - blocker, axis=1).min() > 0.2 + mission.robot.radius
+
+
+def test_fully_blocked_door_aborts_after_bounded_replans(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """The office door is closed by people standing in it: no way in, so ABORTED."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(3.9, 5.0, math.pi / 2), Pose2D(3.9, 7.5)
+    wall = np.column_stack((np.linspace(3.5, 4.4, 30), np.full(30, 5.8)))
+    nav.start(goal, start)
+    poses, _ = _drive(nav, start, 120.0, lambda pose: wall)
+    assert nav.status is NavStatus.ABORTED
+    assert nav.replans >= 1
+    assert max(p.y for p in poses) < 5.8 - mission.robot.radius
+
+
+def test_cancel_and_new_goal(mission: Mission, planner: GridPlanner) -> None:
+    nav = _navigator(mission, planner)
+    assert nav.status is NavStatus.IDLE
+    nav.start(Pose2D(3.0, 2.5), Pose2D(1.0, 3.3))
+    nav.cancel()
+    assert nav.status is NavStatus.PREEMPTED
+    assert nav.update(Pose2D(1.0, 3.3), DT) == Twist2D()
+
+
+def test_keep_clear_slides_along_walls_and_stops_short_of_people() -> None:
+    here, r = np.array([0.0, 0.0]), 0.2
+    none = np.empty((0, 2))
+    v = np.array([0.3, 0.1])
+    assert np.allclose(keep_clear(v, here, none, none, r), v)  # nothing near: unchanged
+    wall = np.array([[r + WALL_MARGIN - 0.01, 0.0]])  # a wall point just ahead
+    assert np.allclose(keep_clear(v, here, none, wall, r), [0.0, 0.1])  # slides along it
+    far_wall = np.array([[r + WALL_MARGIN + 0.05, 0.0]])
+    assert np.allclose(keep_clear(v, here, none, far_wall, r), v)
+    leg = np.array([[0.25, 0.25]])  # a person's leg within the radius + PERSON_MARGIN
+    assert np.hypot(*leg[0]) < r + PERSON_MARGIN
+    out = keep_clear(v, here, leg, none, r)
+    assert out @ (leg[0] / np.linalg.norm(leg[0])) <= 1e-12  # no approach
+    assert np.allclose(keep_clear(-v, here, leg, none, r), -v)  # moving away is free
+    # a doorway: jambs left and right, straight through stays possible
+    jambs = np.array([[0.0, r + 0.03], [0.0, -(r + 0.03)]])
+    assert np.allclose(keep_clear(np.array([0.3, 0.0]), here, none, jambs, r), [0.3, 0.0])
+    # two walls in a corner: neither is approached after the two passes
+    corner = np.array([[r, 0.0], [0.0, r]])
+    out = keep_clear(np.array([0.3, 0.3]), here, none, corner, r)
+    assert out[0] <= 1e-12 and out[1] <= 1e-12
+
+
+def test_navigator_does_not_drive_into_a_person_standing_on_its_path(
+    planner: GridPlanner,
+) -> None:
+    nav = Navigator(planner, 0.6, 1.2)
+    pose = Pose2D(1.0, 5.0, 0.0)
+    nav.start(Pose2D(6.0, 5.0, 0.0), pose)  # along the hall
+    person = np.array([1.6, 5.0])
+    legs = person + np.array([[0.0, 0.1], [0.0, -0.1]])
+    for _ in range(40):
+        cmd = nav.update(pose, DT, legs)
+        c, s = math.cos(pose.theta), math.sin(pose.theta)
+        vx, vy = c * cmd.vx - s * cmd.vy, s * cmd.vx + c * cmd.vy
+        pose = Pose2D(pose.x + vx * DT, pose.y + vy * DT, pose.theta + cmd.wz * DT)
+        gap = np.linalg.norm(legs - (pose.x, pose.y), axis=1).min()
+        assert gap >= planner.robot_radius + PERSON_MARGIN - 0.07  # one step of overshoot

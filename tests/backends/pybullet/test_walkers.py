@@ -1,0 +1,113 @@
+"""Kinematic people: routes through doors at their speed, leg patterns, pauses, determinism."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import shapely
+
+from pfctl.backends.pybullet.walkers import LEG_RADIUS, PERSON_RADIUS, make_walkers
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.walls import wall_footprint
+from pfctl.mission import Mission, ScenarioConfig
+
+DT = 0.05
+
+
+def _run(mission: Mission, planner: GridPlanner, seed: int, seconds: float) -> dict:
+    walkers = make_walkers(mission, planner, seed)
+    log: dict[str, list] = {w.name: [] for w in walkers}
+    for _ in range(int(seconds / DT)):
+        for w in walkers:
+            w.step(DT)
+            s = w.state
+            log[w.name].append((s.x, s.y, s.theta, s.speed, *s.legs.ravel(), s.paused))
+    return {k: np.array(v) for k, v in log.items()}
+
+
+def test_walkers_follow_routes_through_doors_at_their_speed(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    log = _run(mission, planner, seed=3, seconds=60.0)
+    layout = mission.layout()
+    walls = wall_footprint(layout, mission.map.wall_thickness)
+    regions = {r.name: shapely.Polygon(r.polygon) for r in layout.regions}
+    people = {p.name: p for p in mission.scenario.people}
+    walkers = {w.name: w for w in make_walkers(mission, planner, 3)}
+    assert walkers["alice"].is_target and not walkers["bob"].is_target
+    for name, rows in log.items():
+        xy = rows[:, :2]
+        # never inside a wall: the body centre keeps a person's radius from every wall
+        assert shapely.distance(walls, shapely.points(xy)).min() > PERSON_RADIUS - 0.06
+        # starts in the first region, visits every stop, ends in the last one (no loop)
+        # (a stop is a region's name or a point, reached within 0.3 m)
+        route = [
+            regions[s] if isinstance(s, str) else shapely.Point(s).buffer(0.3)
+            for s in people[name].route
+        ]
+        for stop in route:
+            assert shapely.contains_xy(stop, xy[:, 0], xy[:, 1]).any()
+        assert route[0].contains(shapely.Point(xy[0]))
+        assert route[-1].contains(shapely.Point(xy[-1]))
+        # speed: cruises at the mission's speed, never faster; real displacement matches
+        speed = rows[:, 3]
+        assert speed.max() == pytest.approx(people[name].speed, abs=1e-9)
+        step = np.linalg.norm(np.diff(xy, axis=0), axis=1) / DT
+        assert step.max() <= people[name].speed + 1e-6
+        assert (speed[speed > 0] > 0.9 * people[name].speed).mean() > 0.5
+        # pauses at the intermediate stop, and stands at the end
+        assert rows[-1, -1] == 1.0 and rows[-1, 3] == 0.0
+    # alice: kitchen -> hall -> office, through the kitchen-hall door and the office's door
+    a = log["alice"][:, :2]
+    for y_wall, (x0, x1) in ((4.0, (2.0, 2.9)), (6.0, (3.5, 4.4))):
+        k = np.flatnonzero(np.diff(np.sign(a[:, 1] - y_wall)) != 0)
+        assert len(k) == 1 and x0 < a[k[0], 0] < x1
+
+
+def test_legs_swing_while_walking_and_stand_together_when_paused(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    rows = _run(mission, planner, seed=3, seconds=60.0)["alice"]
+    legs = rows[:, 4:10].reshape(-1, 2, 3)
+    assert np.all(legs[:, :, 2] == LEG_RADIUS)
+    gap = np.linalg.norm(legs[:, 0, :2] - legs[:, 1, :2], axis=1)
+    walking = rows[:, 3] > 0.5
+    assert walking.sum() > 100
+    assert gap[walking].min() >= 0.1 and gap[walking].max() <= 0.4
+    assert gap[walking].max() - gap[walking].min() > 0.08  # they really swing
+    # the legs are on either side of the body centre
+    centre = legs[:, :, :2].mean(axis=1)
+    assert np.linalg.norm(centre - rows[:, :2], axis=1).max() < 1e-9
+    still = rows[:, -1] == 1.0
+    assert still.sum() > 20
+    assert np.allclose(gap[still][-10:], 0.2, atol=0.01)
+
+
+def test_same_seed_same_trajectories_other_seed_differs(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    a = _run(mission, planner, seed=11, seconds=20.0)
+    b = _run(mission, planner, seed=11, seconds=20.0)
+    c = _run(mission, planner, seed=12, seconds=20.0)
+    assert all(np.array_equal(a[k], b[k]) for k in a)
+    assert any(not np.array_equal(a[k], c[k]) for k in a)
+
+
+def test_look_alike_loop_and_random_people(mission: Mission, planner: GridPlanner) -> None:
+    people = [p.model_dump() for p in mission.scenario.people]
+    people[1]["loop"] = True
+    people[2]["clothes"] = people[0]["clothes"]  # carol dressed like the target
+    scenario = {**mission.scenario.model_dump(), "people": people, "random_people": 2}
+    m = mission.model_copy(update={"scenario": ScenarioConfig.model_validate(scenario)})
+    walkers = make_walkers(m, planner, seed=5)
+    names = [w.name for w in walkers]
+    assert names[-2:] == ["walker_0", "walker_1"] and len(walkers) == 5
+    target = next(w for w in walkers if w.is_target)
+    look_alikes = [w for w in walkers if w.clothes == target.clothes and w is not target]
+    assert look_alikes
+    bob = walkers[1]
+    for _ in range(int(150 / DT)):
+        bob.step(DT)
+    assert not bob.done  # a looping person keeps walking
+    again = make_walkers(m, planner, seed=5)
+    assert [w.clothes for w in again] == [w.clothes for w in walkers]

@@ -1,0 +1,327 @@
+"""Algorithm 2: clothes histograms, the target profile file, and per-track decisions over time.
+
+The decisions are tested end to end on synthetic pictures of people (shirt, trousers, and a real
+LFW face or the back of a head) through the real dlib models.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+import pytest
+from skimage.data import lfw_subset
+
+from pfctl.core.perception.clothes import (
+    ClothesParams,
+    body_parts,
+    color_histogram,
+    histogram_intersection,
+)
+from pfctl.core.perception.faces import FaceEncoder
+from pfctl.core.perception.identity.identifier import (
+    PROFILE_VERSION,
+    Decision,
+    IdentityParams,
+    TargetIdentifier,
+    TargetProfile,
+    describe,
+    learn_profile,
+)
+from pfctl.core.perception.vision import PersonDetection
+from pfctl.errors import UserError
+
+RED, GREEN, NAVY, GREY = (200, 30, 40), (30, 160, 60), (40, 40, 120), (90, 90, 90)
+TARGET_FACE, OTHER_FACE = 20, 77  # two LFW faces far apart in dlib's embedding space
+
+
+def test_histogram_intersection_with_itself_is_one_and_with_a_disjoint_one_zero() -> None:
+    rng = np.random.default_rng(0)
+    h = rng.random(64)
+    h /= h.sum()
+    assert histogram_intersection(h, h) == pytest.approx(1.0)
+    a, b = np.zeros(64), np.zeros(64)
+    a[:32], b[32:] = 1 / 32, 1 / 32
+    assert histogram_intersection(a, b) == 0.0
+    # normalised by the target's mass: S(I, T) = Σ min / Σ T
+    assert histogram_intersection(a / 2, a) == pytest.approx(0.5)
+    with pytest.raises(ValueError, match="size"):
+        histogram_intersection(a, np.ones(3))
+
+
+def test_color_histograms_are_normalised_and_separate_colours() -> None:
+    params = ClothesParams("hsv", (16, 4, 4))
+    img = np.zeros((20, 20, 3), np.uint8)
+    img[:10], img[10:] = RED, GREEN
+    top, bottom = np.zeros((20, 20), bool), np.zeros((20, 20), bool)
+    top[:10], bottom[10:] = True, True
+    ht, hb = color_histogram(img, top, params), color_histogram(img, bottom, params)
+    assert ht is not None and hb is not None
+    assert ht.shape == (params.size,) and ht.sum() == pytest.approx(1.0)
+    assert histogram_intersection(ht, hb) == 0.0
+    assert color_histogram(img, np.zeros((20, 20), bool), params) is None
+    for space in ("rgb", "lab"):
+        h = color_histogram(img, top, ClothesParams(space, (8, 8, 8)))  # type: ignore[arg-type]
+        assert h is not None and h.sum() == pytest.approx(1.0)
+
+
+def test_body_split_uses_keypoints_else_fixed_fractions_of_the_box() -> None:
+    shape, box = (200, 100), (20, 0, 80, 200)
+    upper, lower = body_parts(shape, box)
+    rows_u, rows_l = np.nonzero(upper.any(axis=1))[0], np.nonzero(lower.any(axis=1))[0]
+    assert (rows_u.min(), rows_u.max()) == (40, 95)  # 20..48 % of 200 rows
+    assert (rows_l.min(), rows_l.max()) == (110, 189)  # 55..95 %
+    assert not upper[:, :35].any() and upper[:, 35:65].all(axis=1).any()  # the central half
+    kp = {"neck": (50.0, 50.0), "mid_hip": (50.0, 150.0), "ankles": (50.0, 190.0)}
+    upper, lower = body_parts(shape, box, keypoints=kp)
+    rows_u, rows_l = np.nonzero(upper.any(axis=1))[0], np.nonzero(lower.any(axis=1))[0]
+    assert 50 <= rows_u.min() <= 55 and 145 <= rows_u.max() < 150
+    assert 150 < rows_l.min() <= 155 and rows_l.max() == 189
+
+
+def _profile(faces: int = 2) -> TargetProfile:
+    rng = np.random.default_rng(1)
+    upper, lower = rng.random(256), rng.random(256)
+    return TargetProfile(
+        upper / upper.sum(), lower / lower.sum(), rng.normal(size=(faces, 128)), frames=7
+    )
+
+
+def test_profile_round_trips_through_npz_and_bad_files_are_user_errors(tmp_path) -> None:
+    prof = _profile()
+    path = prof.save(tmp_path / "t.npz")
+    back = TargetProfile.load(path)
+    assert np.array_equal(back.upper, prof.upper) and np.array_equal(back.faces, prof.faces)
+    assert (back.color_space, back.bins, back.frames) == ("hsv", (16, 4, 4), 7)
+    assert TargetProfile.load(_profile(0).save(tmp_path / "noface.npz")).faces.shape == (0, 128)
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    np.savez(tmp_path / "old.npz", **{**_fields(prof), "version": np.array(PROFILE_VERSION + 1)})
+    np.savez(tmp_path / "bins.npz", **{**_fields(prof), "bins": np.array([8, 4, 4])})
+    np.savez(tmp_path / "part.npz", upper=prof.upper)
+    obj = np.array([{"evil": 1}], dtype=object)
+    np.savez(tmp_path / "pickle.npz", **{**_fields(prof), "faces": obj})
+    cases = {
+        "missing.npz": "no such",
+        "junk.npz": "not a target profile",
+        "old.npz": "version",
+        "bins.npz": "upper",
+        "part.npz": "missing",
+        "pickle.npz": "not a target profile",
+    }
+    for name, words in cases.items():
+        with pytest.raises(UserError, match=words) as err:
+            TargetProfile.load(tmp_path / name)
+        assert name in str(err.value) and "\n" not in str(err.value)
+
+
+def _fields(prof: TargetProfile) -> dict[str, np.ndarray]:
+    with np.load(__import__("io").BytesIO(prof.to_bytes())) as data:
+        return {k: data[k] for k in data.files}
+
+
+def test_a_profile_in_other_bins_than_the_mission_is_refused() -> None:
+    params = IdentityParams(clothes=ClothesParams("rgb", (8, 8, 8)))
+    with pytest.raises(UserError, match="learn it again"):
+        TargetIdentifier(_profile(), params)
+
+
+# -- decisions over time, on pictures through the real dlib models ----------------------------
+
+
+def _picture(shirt, face: int | None) -> tuple[np.ndarray, PersonDetection]:
+    """A 240x160 picture of a person: head 60x72 px (an LFW face, or the back of the head when
+    ``face`` is None), shirt and navy trousers; the detection an OpenPose source would give."""
+    img = np.full((240, 160, 3), GREY, np.uint8)
+    if face is None:
+        img[4:76, 50:110] = (60, 40, 30)  # hair
+    else:
+        gray = (lfw_subset()[face] * 255).astype(np.uint8)
+        img[4:76, 50:110] = np.dstack([cv2.resize(gray, (60, 72), cv2.INTER_CUBIC)] * 3)
+    img[80:150, 30:130] = shirt
+    img[150:236, 40:120] = NAVY
+    kp = {"neck": (80.0, 80.0), "mid_hip": (80.0, 150.0), "ankles": (80.0, 236.0)}
+    det = PersonDetection(
+        (30, 4, 130, 236), (2.0, 0.0, 1.0), keypoints=kp, head_box=(50, 4, 110, 76)
+    )
+    return img, det
+
+
+@pytest.fixture(scope="module")
+def learned() -> tuple[TargetProfile, IdentityParams, FaceEncoder]:
+    params = IdentityParams()
+    encoder = FaceEncoder(params.face)
+    views = [_picture(RED, TARGET_FACE), _picture(RED, None)]
+    profile = learn_profile([describe(img, det, params, encoder) for img, det in views], params)
+    assert len(profile.faces) == 1
+    return profile, params, encoder
+
+
+def test_a_face_match_carries_the_track_through_back_views(learned) -> None:
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    first = ident.observe(1, 0.0, True, *reversed(_picture(RED, TARGET_FACE)))
+    assert first.decision is Decision.TARGET and first.basis == "face"
+    assert first.face_distance is not None and first.face_distance < 0.3
+    for k in range(1, 4):  # the target turns around: no face any more
+        later = ident.observe(1, 0.1 * k, True, *reversed(_picture(RED, None)))
+        assert later.decision is Decision.TARGET and later.basis == "face"
+    assert later.face_samples == 1 and later.clothes_samples == 4 and later.observations == 4
+    assert ident.target_track() == 1
+
+
+def test_a_mismatching_face_stays_rejected_even_when_the_clothes_match(learned) -> None:
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    seen = ident.observe(2, 0.0, True, *reversed(_picture(RED, OTHER_FACE)))
+    assert seen.decision is Decision.NOT_TARGET and seen.basis == "face"
+    assert seen.clothes_similarity is not None and seen.clothes_similarity > 0.9
+    for k in range(1, 4):
+        later = ident.observe(2, 0.1 * k, True, *reversed(_picture(RED, None)))
+        assert later.decision is Decision.NOT_TARGET
+    # a look-alike seen only from behind is the target by its clothes, until a face decides
+    back = ident.observe(3, 0.5, True, *reversed(_picture(RED, None)))
+    assert back.decision is Decision.TARGET and back.basis == "clothes"
+    assert ident.target_track() == 3
+    green = ident.observe(4, 0.5, True, *reversed(_picture(GREEN, None)))
+    assert green.decision is Decision.NOT_TARGET and green.basis == "clothes"
+    # the true target's face outranks clothes alone
+    ident.observe(5, 0.6, True, *reversed(_picture(RED, TARGET_FACE)))
+    assert ident.target_track() == 5
+    ident.forget(5)
+    assert ident.identity(5) is None and ident.target_track() == 3
+
+
+def test_tracks_without_legs_are_not_candidates_and_unseen_tracks_keep_their_evidence(
+    learned,
+) -> None:
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    no_legs = ident.observe(7, 0.0, False, *reversed(_picture(RED, TARGET_FACE)))
+    assert no_legs.decision is Decision.UNKNOWN and no_legs.basis == "no_legs"
+    assert ident.target_track() is None
+    legs = ident.observe(7, 0.1, True, None, None)  # legs now; the camera did not see it
+    assert legs.decision is Decision.TARGET and legs.face_samples == 1
+    assert ident.observe(8, 0.1, True, None, None).decision is Decision.UNKNOWN
+
+
+def test_describe_on_the_box_equals_the_whole_image() -> None:
+    """describe() cuts the image and the body masks to the person's box: the histograms are the
+    ones of the whole-image masks, bit for bit — with a mask, with a mask reaching outside its
+    box (then the whole image is used), without one, and for boxes over the image's edge."""
+    rng = np.random.default_rng(3)
+    params = IdentityParams()
+    h, w = 120, 160
+    for trial in range(60):
+        img = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+        x0, y0 = int(rng.integers(-20, w - 10)), int(rng.integers(-20, h - 10))
+        box = (x0, y0, x0 + int(rng.integers(5, 80)), y0 + int(rng.integers(5, 120)))
+        mask = None
+        if trial % 3:
+            mask = np.zeros((h, w), bool)
+            cut = (slice(max(0, box[1]), max(0, box[3])), slice(max(0, box[0]), max(0, box[2])))
+            mask[cut] = rng.random(mask[cut].shape) < 0.7
+            if trial % 3 == 2:
+                mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True  # maybe outside
+        kp = None
+        if trial % 2:
+            top = box[1] + 0.2 * (box[3] - box[1])
+            kp = {"neck": (0.0, top), "mid_hip": (0.0, top + 0.3 * (box[3] - box[1]))}
+        det = PersonDetection(box, (1.0, 0.0, 1.0), mask=mask, keypoints=kp)
+        upper, lower = body_parts((h, w), box, mask, kp)
+        got = describe(img, det, params)
+        for part, full in ((got.upper, upper), (got.lower, lower)):
+            want = color_histogram(img, full, params.clothes)
+            assert (part is None and want is None) or np.array_equal(part, want), trial
+
+
+def _shirt(upper_rows: tuple[int, int], colours: tuple) -> tuple[np.ndarray, PersonDetection]:
+    """A person without a face: the shirt ``colours`` in horizontal bands, navy trousers."""
+    img = np.full((240, 160, 3), GREY, np.uint8)
+    bands = np.array_split(np.arange(*upper_rows), len(colours))
+    for rows, colour in zip(bands, colours, strict=True):
+        img[rows[0] : rows[-1] + 1, 30:130] = colour
+    img[150:236, 40:120] = NAVY
+    kp = {"neck": (80.0, 80.0), "mid_hip": (80.0, 150.0), "ankles": (80.0, 236.0)}
+    return img, PersonDetection((30, 4, 130, 236), (2.0, 0.0, 1.0), keypoints=kp)
+
+
+def test_settled_clothes_are_measured_less_often_and_decide_the_same() -> None:
+    """Clothes far from the threshold are measured every ``clothes_recheck_s`` once a track has
+    ``clothes_settled`` samples; clothes near it on every frame; the decisions are those of an
+    identifier that measures every frame."""
+    params = IdentityParams(faces=False)
+    red = describe(*_shirt((80, 150), (RED,)), params)
+    profile = learn_profile([red], params)
+    every = TargetIdentifier(profile, IdentityParams(faces=False, clothes_recheck_s=0.0))
+    throttled = TargetIdentifier(profile, params)
+    people = {
+        1: _shirt((80, 150), (RED,)),  # the target's shirt: S ≈ 1
+        2: _shirt((80, 150), (GREEN,)),  # S ≈ 0
+        3: _shirt((80, 150), (RED, GREEN)),  # half of it: S ≈ 0.5, near the threshold 0.6
+    }
+    for k in range(30):
+        t = 0.1 * k
+        for tid, (img, det) in people.items():
+            a = every.observe(tid, t, True, det, img)
+            b = throttled.observe(tid, t, True, det, img)
+            assert (a.decision, a.basis) == (b.decision, b.basis), (k, tid)
+    ids = throttled.identities()
+    assert [ids[i].decision for i in (1, 2)] == [Decision.TARGET, Decision.NOT_TARGET]
+    assert ids[3].clothes_similarity is not None
+    assert abs(ids[3].clothes_similarity - params.clothes_similarity) < params.clothes_margin
+    # 10 samples in the first second, then one every 0.5 s; near the threshold: every frame
+    assert ids[1].clothes_samples == ids[2].clothes_samples == 10 + 4
+    assert ids[3].clothes_samples == 30 and every.identities()[1].clothes_samples == 30
+    assert throttled.face_stats.clothes_skipped == 2 * (30 - 14)
+
+
+def test_a_track_a_face_decides_is_settled_whatever_its_clothes(learned) -> None:
+    """Once a face decides, clothes no longer enter the decision: after ``clothes_settled``
+    samples they are measured only every ``clothes_recheck_s``, even near the threshold."""
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    assert ident.observe(1, 0.0, True, *reversed(_picture(RED, TARGET_FACE))).basis == "face"
+    img, det = _shirt((80, 150), (RED, GREEN))  # the back, in a shirt near the threshold
+    for k in range(1, 15):
+        later = ident.observe(1, 0.1 * k, True, det, img)
+        assert later.decision is Decision.TARGET and later.basis == "face"
+    assert later.clothes_samples == 10 + 1  # frames 0-9, then 1.4 s
+
+
+def _reference_histogram(img: np.ndarray, mask: np.ndarray, params: ClothesParams) -> np.ndarray:
+    """The soft histogram computed pixel by pixel, as written before the lookup tables."""
+    ranges = {"hsv": [0, 180, 0, 256, 0, 256]}.get(params.color_space, [0, 256] * 3)
+    pixels = img[mask].astype(np.float64)
+    parts = [(np.zeros(len(pixels), dtype=np.int64), np.ones(len(pixels)))]
+    for channel, bins in enumerate(params.bins):
+        lo, hi = ranges[2 * channel], ranges[2 * channel + 1]
+        u = (pixels[:, channel] - lo) / (hi - lo) * bins - 0.5
+        k0 = np.floor(u)
+        frac = u - k0
+        k0 = k0.astype(np.int64)
+        k1 = k0 + 1
+        if params.color_space == "hsv" and channel == 0:
+            k0, k1 = k0 % bins, k1 % bins
+        else:
+            k0, k1 = np.clip(k0, 0, bins - 1), np.clip(k1, 0, bins - 1)
+        parts = [
+            (idx * bins + k, w * f) for idx, w in parts for k, f in ((k0, 1.0 - frac), (k1, frac))
+        ]
+    hist = np.zeros(params.size)
+    for idx, w in parts:
+        hist += np.bincount(idx, weights=w, minlength=params.size)
+    return hist / hist.sum()
+
+
+def test_histogram_tables_give_the_per_pixel_histogram_bit_for_bit() -> None:
+    rng = np.random.default_rng(9)
+    for space in ("hsv", "rgb", "lab"):
+        for bins in ((16, 4, 4), (8, 8, 8), (3, 5, 2), (1, 1, 7)):
+            params = ClothesParams(space, bins)  # type: ignore[arg-type]
+            img = rng.integers(0, 256, (60, 70, 3), dtype=np.uint8)
+            if space == "hsv":
+                img[..., 0] %= 180
+            mask = rng.random((60, 70)) < 0.4
+            got = color_histogram(img, mask, params, converted=True)
+            assert np.array_equal(got, _reference_histogram(img, mask, params)), (space, bins)
+    with pytest.raises(ValueError, match="8-bit"):
+        color_histogram(np.zeros((4, 4, 3)), np.ones((4, 4), bool), params, converted=True)
