@@ -42,12 +42,9 @@ import numpy as np  # noqa: E402
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
 from pfctl.core.perception.clothes import convert  # noqa: E402
 from pfctl.core.perception.faces import FaceEncoder  # noqa: E402
-from pfctl.core.perception.identity.identifier import (  # noqa: E402
-    IdentityParams,
-    TargetIdentifier,
-    describe,
-    learn_profile,
-)
+from pfctl.core.perception.identity.identifier import TargetIdentifier  # noqa: E402
+from pfctl.core.perception.identity.params import IdentityParams  # noqa: E402
+from pfctl.core.perception.identity.profile import describe, learn_profile  # noqa: E402
 from pfctl.core.perception.vision import MaskPersonDetector  # noqa: E402
 from pfctl.core.robot import HeadTarget, RgbdFrame  # noqa: E402
 from pfctl.mission import loads_mission  # noqa: E402

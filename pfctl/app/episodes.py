@@ -25,7 +25,8 @@ from pfctl.core.episode import EpisodeLog, TickRecord
 from pfctl.core.mapping.grid import FREE
 from pfctl.core.metrics import MetricParams, search_metrics
 from pfctl.core.perception.face_worker import FaceWorker
-from pfctl.core.perception.identity.identifier import FaceTiming, TargetProfile, learn_profile
+from pfctl.core.perception.identity.params import FaceTiming
+from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.perception.vision import PersonDetector
 from pfctl.core.robot import GroundTruth, Observation, Robot
 from pfctl.errors import UserError

@@ -16,12 +16,9 @@ from pfctl.core.mapping.grid import GridGeometry
 from pfctl.core.perception.belief import BeliefParams, HumanBelief
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.face_worker import FaceWorker
-from pfctl.core.perception.identity.identifier import (
-    FaceTiming,
-    IdentityParams,
-    TargetIdentifier,
-    TargetProfile,
-)
+from pfctl.core.perception.identity.identifier import TargetIdentifier
+from pfctl.core.perception.identity.params import FaceTiming, IdentityParams
+from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.core.perception.legs.detector import LegDetector, LegParams, load_leg_model
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.perception.tracking import MultiPersonTracker, TrackerParams

@@ -60,7 +60,7 @@ from pfctl.core.metrics import (
     search_metrics,
 )
 from pfctl.core.perception.face_worker import FaceWorkerError
-from pfctl.core.perception.identity.identifier import TargetProfile
+from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
 from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission

@@ -1,6 +1,6 @@
 """`pfctl learn-target MISSION --out target.npz`: learn what the target looks like (§II-E).
 
-The profile (:class:`pfctl.core.perception.identity.identifier.TargetProfile`) holds the target's
+The profile (:class:`pfctl.core.perception.identity.profile.TargetProfile`) holds the target's
 upper- and lower-body clothing histograms in the mission's ``perception.identity`` colour space and
 bins, and the 128-D embeddings of their face. Two sources:
 
@@ -47,9 +47,9 @@ from pfctl.app.perception import identity_params
 from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.faces import FaceEncoder
-from pfctl.core.perception.identity.identifier import (
+from pfctl.core.perception.identity.params import IdentityParams
+from pfctl.core.perception.identity.profile import (
     Appearance,
-    IdentityParams,
     TargetProfile,
     describe,
     learn_profile,

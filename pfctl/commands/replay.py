@@ -29,7 +29,7 @@ from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.bags.replay import Replay, open_replay
 from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.episode import TrackRow
-from pfctl.core.perception.identity.identifier import TargetProfile
+from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.perception.vision import (
     GivenPersonDetector,

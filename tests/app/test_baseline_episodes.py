@@ -18,7 +18,7 @@ from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
 from pfctl.core.episode import TickRecord
-from pfctl.core.perception.identity.identifier import TargetProfile, learn_profile
+from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.mission import load_mission
 
 MISSIONS = Path(__file__).resolve().parents[2] / "missions"

@@ -15,7 +15,7 @@ from pfctl.app.perception import identity_params
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.commands.learn_target import learn_from_images
 from pfctl.core.perception.clothes import histogram_intersection
-from pfctl.core.perception.identity.identifier import TargetProfile, learn_profile
+from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.perception.vision import MaskPersonDetector
 from pfctl.core.robot import HeadTarget
 from pfctl.errors import UserError

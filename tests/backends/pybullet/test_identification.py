@@ -18,12 +18,8 @@ from pfctl.backends.hsr.person_keypoints import detection_parts, given_person
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.perception.faces import FaceEncoder, face_distance
-from pfctl.core.perception.identity.identifier import (
-    Decision,
-    TargetIdentifier,
-    describe,
-    learn_profile,
-)
+from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
+from pfctl.core.perception.identity.profile import describe, learn_profile
 from pfctl.core.perception.vision import (
     GivenPersonDetector,
     HogPersonDetector,

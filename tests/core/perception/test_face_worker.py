@@ -19,10 +19,9 @@ from skimage.data import astronaut, lfw_subset
 
 from pfctl.core.perception.face_worker import FaceWorker, FaceWorkerError
 from pfctl.core.perception.faces import FaceEncoder, FaceParams
-from pfctl.core.perception.identity.identifier import (
-    Decision,
-    IdentityParams,
-    TargetIdentifier,
+from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
+from pfctl.core.perception.identity.params import IdentityParams
+from pfctl.core.perception.identity.profile import (
     TargetProfile,
     describe,
     face_region,

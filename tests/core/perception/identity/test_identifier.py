@@ -18,11 +18,10 @@ from pfctl.core.perception.clothes import (
     histogram_intersection,
 )
 from pfctl.core.perception.faces import FaceEncoder
-from pfctl.core.perception.identity.identifier import (
+from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
+from pfctl.core.perception.identity.params import IdentityParams
+from pfctl.core.perception.identity.profile import (
     PROFILE_VERSION,
-    Decision,
-    IdentityParams,
-    TargetIdentifier,
     TargetProfile,
     describe,
     learn_profile,

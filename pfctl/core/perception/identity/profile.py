@@ -1,0 +1,272 @@
+"""The target's appearance for Algorithm 2 (§II-E): what one frame shows of a person (clothes
+histograms, a face), and the target's profile learned from such frames.
+
+:class:`TargetProfile` is what ``pfctl learn-target`` writes: the target's upper and lower
+clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, saved as a versioned
+``.npz`` (no pickles).
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from pfctl.core.atomic_files import atomic_write
+from pfctl.core.perception.clothes import (
+    ClothesParams,
+    ColorSpace,
+    body_parts_window,
+    color_histogram,
+    convert,
+    histogram_intersection,
+)
+from pfctl.core.perception.faces import (
+    EMBEDDING_SIZE,
+    Box,
+    FaceEncoder,
+    face_distance,
+)
+from pfctl.core.perception.identity.params import IdentityParams
+from pfctl.core.perception.vision import PersonDetection
+from pfctl.errors import UserError
+
+#: Version of the profile file format.
+PROFILE_VERSION = 1
+#: At most this many face embeddings are kept in a profile (spread over the samples).
+MAX_PROFILE_FACES = 32
+#: A head region narrower than this (pixels) is not searched for a face (too far).
+MIN_HEAD_PX = 12
+
+
+@dataclass(frozen=True)
+class Appearance:
+    """What one detection looks like: clothing histograms (None when that part was not seen)
+    and the face embedding (None when no face was found)."""
+
+    upper: np.ndarray | None
+    lower: np.ndarray | None
+    face: np.ndarray | None = None
+    face_box: Box | None = None
+
+
+def head_region(detection: PersonDetection) -> Box:
+    """Where to look for the face: the detector's head box (widened by a quarter), else the top
+    quarter of the body box's central 60 %."""
+    if detection.head_box is not None:
+        x0, y0, x1, y1 = detection.head_box
+        mx, my = (x1 - x0) // 4 + 1, (y1 - y0) // 4 + 1
+        return x0 - mx, y0 - my, x1 + mx, y1 + my
+    x0, y0, x1, y1 = detection.box
+    w, h = x1 - x0, y1 - y0
+    return int(x0 + 0.2 * w), y0, math.ceil(x1 - 0.2 * w), int(y0 + 0.25 * h)
+
+
+def _head_cut(detection: PersonDetection, shape: tuple[int, ...]) -> bool:
+    """Whether the detector's head box touches the image border (a cut face embeds badly)."""
+    if detection.head_box is None:
+        return False
+    x0, y0, x1, y1 = detection.head_box
+    return x0 <= 0 or y0 <= 0 or x1 >= shape[1] or y1 >= shape[0]
+
+
+def face_region(detection: PersonDetection, shape: tuple[int, ...]) -> Box | None:
+    """The :func:`head_region` to search for the detection's face in an image of ``shape``, or
+    None when it is not worth searching: the head box touches the border (a cut face embeds
+    badly) or the region is narrower than :data:`MIN_HEAD_PX`."""
+    if _head_cut(detection, shape):
+        return None
+    region = head_region(detection)
+    return region if region[2] - region[0] >= MIN_HEAD_PX else None
+
+
+def describe(
+    rgb: np.ndarray,
+    detection: PersonDetection,
+    params: IdentityParams,
+    encoder: FaceEncoder | None = None,
+    converted: np.ndarray | None = None,
+) -> Appearance:
+    """Measure a detection in ``rgb``: its upper/lower histograms and, with ``encoder``, its
+    best face inside :func:`head_region` (not when the head box touches the image border: a cut
+    face embeds badly). ``converted`` is ``rgb`` already in the clothes'
+    colour space (to convert once per frame for several people)."""
+    shape = rgb.shape[:2]
+    (r0, r1, c0, c1), upper_mask, lower_mask = body_parts_window(
+        shape, detection.box, detection.mask, dict(detection.keypoints or {})
+    )
+    # the person's box: the same pixels as the whole image's masks
+    if converted is not None:
+        img = converted[r0:r1, c0:c1]
+    else:
+        img = convert(rgb[r0:r1, c0:c1], params.clothes.color_space)
+    upper = color_histogram(img, upper_mask, params.clothes, converted=True)
+    lower = color_histogram(img, lower_mask, params.clothes, converted=True)
+    face = face_box = None
+    region = face_region(detection, shape) if encoder is not None and params.faces else None
+    if encoder is not None and region is not None:
+        faces = encoder.detect(rgb, region)
+        if faces:
+            face, face_box = faces[0].embedding, faces[0].box
+    return Appearance(upper, lower, face, face_box)
+
+
+# -- the target's profile ------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class TargetProfile:
+    """The target's appearance: normalised upper/lower clothing histograms in ``color_space``
+    with ``bins``, and ``faces`` ``(k, 128)`` embeddings (k may be 0)."""
+
+    upper: np.ndarray
+    lower: np.ndarray
+    faces: np.ndarray
+    color_space: ColorSpace = "hsv"
+    bins: tuple[int, int, int] = (16, 4, 4)
+    frames: int = 0
+    """How many frames the profile was learned from."""
+
+    @property
+    def clothes(self) -> ClothesParams:
+        return ClothesParams(self.color_space, self.bins)
+
+    def face_distance(self, embedding: np.ndarray) -> float | None:
+        """Distance of a face to the target's: the median over the profile's embeddings (robust
+        to a few odd samples in either direction); None if the profile has no face."""
+        if len(self.faces) == 0:
+            return None
+        return float(np.median(face_distance(self.faces, embedding)))
+
+    def similarity(self, appearance: Appearance) -> float | None:
+        """Clothes similarity S of an appearance: the smaller of the upper and lower body's
+        (both must match; a part not seen does not count); None if neither was seen."""
+        s = [
+            histogram_intersection(h, t)
+            for h, t in ((appearance.upper, self.upper), (appearance.lower, self.lower))
+            if h is not None
+        ]
+        return min(s) if s else None
+
+    # .npz I/O ------------------------------------------------------------------------------------
+
+    def to_bytes(self) -> bytes:
+        """The profile as ``.npz`` bytes (version, histograms, faces, colour space, bins)."""
+        buf = io.BytesIO()
+        np.savez(
+            buf,
+            version=np.array(PROFILE_VERSION),
+            upper=np.asarray(self.upper, dtype=np.float64),
+            lower=np.asarray(self.lower, dtype=np.float64),
+            faces=np.asarray(self.faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+            color_space=np.array(self.color_space),
+            bins=np.asarray(self.bins, dtype=np.int64),
+            frames=np.array(self.frames),
+        )
+        return buf.getvalue()
+
+    def save(self, path: str | os.PathLike[str]) -> Path:
+        """Write the profile to ``path`` atomically."""
+        return atomic_write(path, self.to_bytes())
+
+    @classmethod
+    def load(cls, path: str | os.PathLike[str]) -> TargetProfile:
+        """Read a profile written by :meth:`save`; a bad file is a one-line UserError."""
+        name = str(path)
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                fields = {k: data[k] for k in data.files}
+        except FileNotFoundError:
+            raise UserError(f"{name}: no such target profile") from None
+        except (OSError, ValueError) as err:
+            raise UserError(f"{name}: not a target profile (.npz): {err}") from None
+        missing = {"version", "upper", "lower", "faces", "color_space", "bins"} - set(fields)
+        if missing:
+            raise UserError(f"{name}: not a target profile: missing {', '.join(sorted(missing))}")
+        version = int(fields["version"])
+        if version != PROFILE_VERSION:
+            raise UserError(
+                f"{name}: version: expected {PROFILE_VERSION}, got {version} (learn it again)"
+            )
+        space = str(fields["color_space"])
+        if space not in ("hsv", "rgb", "lab"):
+            raise UserError(f"{name}: color_space: expected hsv, rgb or lab, got {space!r}")
+        bins = tuple(int(b) for b in np.ravel(fields["bins"]))
+        if len(bins) != 3 or min(bins) < 1:
+            raise UserError(f"{name}: bins: expected three positive counts, got {bins}")
+        size = int(np.prod(bins))
+        upper, lower = (np.asarray(fields[k], dtype=np.float64).ravel() for k in ("upper", "lower"))
+        for key, h in (("upper", upper), ("lower", lower)):
+            if h.size != size or not np.all(np.isfinite(h)) or np.any(h < 0):
+                raise UserError(
+                    f"{name}: {key}: expected {size} finite non-negative histogram bins"
+                )
+        faces = np.asarray(fields["faces"], dtype=np.float64)
+        if faces.ndim != 2 or faces.shape[1] != EMBEDDING_SIZE or not np.all(np.isfinite(faces)):
+            raise UserError(f"{name}: faces: expected a (k, {EMBEDDING_SIZE}) array")
+        return cls(
+            upper=upper,
+            lower=lower,
+            faces=faces,
+            color_space=space,  # type: ignore[arg-type]
+            bins=bins,  # type: ignore[arg-type]
+            frames=int(fields.get("frames", 0)),
+        )
+
+    def check_params(self, params: IdentityParams, source: str = "profile") -> None:
+        """A UserError unless the profile's histograms are in the mission's colour space/bins."""
+        want = params.clothes
+        if (self.color_space, tuple(self.bins)) != (want.color_space, tuple(want.bins)):
+            raise UserError(
+                f"{source}: histograms are {self.color_space} {list(self.bins)}, the mission's "
+                f"perception.identity wants {want.color_space} {list(want.bins)} (learn it again)"
+            )
+
+
+def learn_profile(
+    appearances: Sequence[Appearance],
+    params: IdentityParams,
+    max_faces: int = MAX_PROFILE_FACES,
+) -> TargetProfile:
+    """The profile of a person from appearances of them (one per frame): the mean of the
+    normalised histograms (renormalised) and up to ``max_faces`` face embeddings spread evenly
+    over the samples. ValueError if no appearance has both clothing parts."""
+    uppers = [a.upper for a in appearances if a.upper is not None]
+    lowers = [a.lower for a in appearances if a.lower is not None]
+    if not uppers or not lowers:
+        raise ValueError("no appearance shows both the upper and the lower body")
+
+    def mean(hs: list[np.ndarray]) -> np.ndarray:
+        m = np.mean(hs, axis=0)
+        return m / m.sum()
+
+    faces = [a.face for a in appearances if a.face is not None]
+    if len(faces) > max_faces:
+        keep = np.linspace(0, len(faces) - 1, max_faces).round().astype(int)
+        faces = [faces[i] for i in keep]
+    return TargetProfile(
+        upper=mean(uppers),
+        lower=mean(lowers),
+        faces=np.array(faces, dtype=np.float64).reshape(-1, EMBEDDING_SIZE),
+        color_space=params.clothes.color_space,
+        bins=params.clothes.bins,
+        frames=len(appearances),
+    )
+
+
+__all__ = [
+    "MAX_PROFILE_FACES",
+    "MIN_HEAD_PX",
+    "PROFILE_VERSION",
+    "Appearance",
+    "TargetProfile",
+    "describe",
+    "face_region",
+    "head_region",
+    "learn_profile",
+]
