@@ -89,7 +89,7 @@ def run(
     from pfctl.backends.pybullet.runner import graceful_interrupts, run_episode
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
     from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
-    from pfctl.plots.sim_run import plot_episode
+    from pfctl.plots.sim_run import plot_paths
 
     if not (math.isfinite(duration) and duration > 0):
         raise UserError(f"--duration: expected a positive number of seconds, got {duration}")
@@ -167,7 +167,15 @@ def run(
         except OSError as err:
             raise UserError(f"--png {png}: cannot create its folder: {err.strerror}") from None
         title = f"{loaded.name}: {result.sim_time:.1f} s simulated, seed {robot.seed}"
-        picture = plot_episode(robot.static_map, loaded.layout(), episode, png, title=title)
+        picture = plot_paths(
+            robot.static_map,
+            loaded.layout(),
+            episode.robot_path(),
+            episode.people_paths(),
+            episode.target,
+            png,
+            title=title,
+        )
     _report(loaded, result, robot.collisions, picture, record)
     if result.interrupted:
         raise typer.Exit(130)

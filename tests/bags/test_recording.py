@@ -82,12 +82,21 @@ def test_missing_bag_is_an_error(tmp_path: Path) -> None:
 def test_episode_png(tmp_path: Path) -> None:
     from pfctl.core.mapping.walls import rasterize_house
     from pfctl.mission import load_mission
-    from pfctl.plots.sim_run import plot_episode
+    from pfctl.plots.sim_run import plot_paths
 
     mission = load_mission(Path(__file__).resolve().parents[2] / "missions" / "house.yaml")
     grid = rasterize_house(mission.layout(), 0.05, wall_thickness=mission.map.wall_thickness)
     with EpisodeRecorder(tmp_path / "ep", "house") as rec:
         for i in range(6):
             rec.add(*_tick(i))
-    out = plot_episode(grid, mission.layout(), read_episode(tmp_path / "ep"), tmp_path / "e.png")
+    episode = read_episode(tmp_path / "ep")
+    out = plot_paths(
+        grid,
+        mission.layout(),
+        episode.robot_path(),
+        episode.people_paths(),
+        episode.target,
+        tmp_path / "e.png",
+        title=episode.mission_name,
+    )
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
