@@ -21,6 +21,8 @@ from pfctl.core.episode import TickRecord
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.mission import load_mission
 
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
+
 MISSIONS = Path(__file__).resolve().parents[2] / "missions"
 SEED = 1
 SECONDS = 15.0

@@ -24,6 +24,7 @@ sys.stdout.write(np.concatenate(out).tobytes().hex())
 """
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="glibc's mallopt")
 def test_retaining_freed_memory_is_accepted_and_changes_no_result() -> None:
     """glibc accepts the settings (twice: idempotent), and the same large-array computation

@@ -11,6 +11,8 @@ from pfctl.app.perception import build_perception
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.mission import loads_mission
 
+pytestmark = pytest.mark.sim
+
 # Ann and Ben walk X-shaped paths that cross at (5, 3), 4 m in front of the robot; Ben is slower,
 # so he passes the crossing point about 0.6 m behind Ann, partly hidden by her for a moment.
 CROSSING = (Path(__file__).parent / "crossing.yaml").read_text()

@@ -23,6 +23,8 @@ from pfctl.core.robot import (
     Twist2D,
 )
 
+pytestmark = pytest.mark.sim
+
 
 def _tick(i: int) -> tuple[Observation, GroundTruth]:
     t = 0.1 * i

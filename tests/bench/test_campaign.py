@@ -17,6 +17,8 @@ from typing import Any
 
 import pytest
 
+pytestmark = [pytest.mark.sim, pytest.mark.slow]
+
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 ARGS = ["--episodes", "4", "--seed", "3", "--duration", "15", "--workers", "2"]
 #: Wall seconds any one command may take (4 short episodes on a busy 2-core machine: ~2 min).

@@ -124,6 +124,7 @@ def test_a_campaign_writes_records_and_the_summary(
     assert "following rate" in stdout and "[4/4]" in err
 
 
+@pytest.mark.slow
 def test_resume_runs_only_what_is_missing(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

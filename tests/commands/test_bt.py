@@ -159,6 +159,7 @@ def test_a_mission_with_a_bad_leaf_exits_2_with_one_line(
     assert [p.name for p in tmp_path.iterdir()] == ["m.yaml"]  # no PNG written
 
 
+@pytest.mark.slow
 def test_console_script_in_a_subprocess(tmp_path: Path) -> None:
     exe = shutil.which("pfctl", path=str(Path(sys.executable).parent))
     if exe is None:

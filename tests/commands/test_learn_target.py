@@ -42,6 +42,8 @@ scenario:
 """
 
 
+@pytest.mark.sim
+@pytest.mark.slow
 def test_learn_target_in_the_simulated_house(tmp_path, capsys, monkeypatch) -> None:
     out, png = tmp_path / "t.npz", tmp_path / "t.png"
     args = ["learn-target", str(HOUSE), "--backend", "sim", "--out", str(out)]

@@ -68,6 +68,7 @@ def house_map(tmp_path_factory) -> Path:
     return out
 
 
+@pytest.mark.slow
 def test_auto_annotation_of_the_exported_house_finds_every_room(house_map, tmp_path) -> None:
     """THE KEY TEST. IoU is of shapely polygons: proposed region vs. the house.yaml region."""
     mission_path, png = tmp_path / "m.yaml", tmp_path / "m.png"

@@ -50,6 +50,7 @@ def _run(args: list[str], mp: pytest.MonkeyPatch) -> int:
     return 0
 
 
+@pytest.mark.sim
 def test_replay_of_a_sim_recording_tracks_the_people_in_the_map_frame(
     episode: Path,
     tmp_path: Path,

@@ -15,6 +15,8 @@ from pfctl.app.episodes import hide_target
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.mission import load_mission
 
+pytestmark = pytest.mark.sim
+
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = ROOT / "missions" / "house.yaml"
 
@@ -49,6 +51,7 @@ def test_the_hidden_target_is_gone_from_the_first_observation() -> None:
         assert (alice.x, alice.y) != start
 
 
+@pytest.mark.slow
 def test_search_finds_the_target_in_the_hall_and_writes_its_files(tmp_path: Path) -> None:
     out = tmp_path / "search"
     result = _pfctl(

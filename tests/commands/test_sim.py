@@ -7,10 +7,13 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import load_mission
+
+pytestmark = pytest.mark.sim
 
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 
@@ -33,6 +36,7 @@ def test_export_map_round_trips(tmp_path: Path) -> None:
     assert np.array_equal(loaded.states(), expected.states())
 
 
+@pytest.mark.slow
 def test_bad_inputs_exit_2_with_one_line(tmp_path: Path) -> None:
     for args in (
         ("sim", "export-map", str(tmp_path / "nope.yaml"), "--out", str(tmp_path / "m.yaml")),

@@ -17,6 +17,8 @@ from pfctl.backends.pybullet.drivers import ScriptError, read_velocity_script
 from pfctl.bags.recording import read_episode
 from tests.conftest import run_cli
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 PNG = b"\x89PNG\r\n\x1a\n"
 
@@ -29,6 +31,7 @@ def _pfctl(*args: str, env: dict[str, str] | None = None) -> subprocess.Complete
     return subprocess.run(_cmd(*args), capture_output=True, text=True, check=False, env=env)
 
 
+@pytest.mark.slow
 def test_a_script_drives_the_robot_and_the_episode_is_recorded(tmp_path: Path) -> None:
     script = tmp_path / "drive.csv"
     script.write_text("t,vx,vy,wz,pan,tilt\n0,0.2,0,0,0.5,-0.2\n4,0,0,0,0,0\n")
@@ -49,6 +52,7 @@ def test_a_script_drives_the_robot_and_the_episode_is_recorded(tmp_path: Path) -
     assert (tmp_path / "ep" / "paths.png").read_bytes()[:8] == PNG
 
 
+@pytest.mark.slow
 def test_the_picture_goes_where_asked_and_the_camera_runs(tmp_path: Path) -> None:
     out = tmp_path / "pics" / "run.png"
     res = _pfctl("sim", "run", str(HOUSE), "--duration", "1", "--png", str(out), "--seed", "3")
@@ -122,6 +126,7 @@ def _read_until(fd: int, needle: bytes, timeout: float) -> bytes:
     return seen
 
 
+@pytest.mark.slow
 def test_teleop_from_a_terminal_drives_and_quits(tmp_path: Path) -> None:
     master, slave = pty.openpty()
     proc = subprocess.Popen(
@@ -148,6 +153,7 @@ def test_teleop_from_a_terminal_drives_and_quits(tmp_path: Path) -> None:
     assert 1.5 < episode.duration < 10  # paced to the clock
 
 
+@pytest.mark.slow
 def test_ctrl_c_ends_the_run_and_keeps_a_complete_episode(tmp_path: Path) -> None:
     proc = subprocess.Popen(
         _cmd("sim", "run", str(HOUSE), "--realtime", "--duration", "600", "--no-camera",

@@ -115,6 +115,7 @@ def test_tilt_sign_for_a_face_above_or_below_the_camera() -> None:
     assert xy.tilt == pytest.approx(math.atan2(1.1 - 1.05, 2.0))
 
 
+@pytest.mark.sim
 def test_gaze_angles_aim_the_simulated_camera_at_the_point() -> None:
     camera = pytest.importorskip("pfctl.backends.pybullet.camera")
     pose = Pose2D(0.5, -1.0, 0.7)
@@ -163,6 +164,7 @@ def test_gaze_pd_converges_without_overshoot_on_a_head_following_its_command(
         assert steps.max() <= PARAMS.head_max_speed * dt + 1e-9
 
 
+@pytest.mark.sim
 def test_gaze_pd_converges_on_the_simulated_head_servo() -> None:
     head_mod = pytest.importorskip("pfctl.backends.pybullet.head")
     from pfctl.mission import RobotConfig

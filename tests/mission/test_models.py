@@ -542,6 +542,7 @@ def test_load_mission_raises_mission_error_for_users_and_loads_mission_names_sou
 # --------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_subprocess_contract_for_a_broken_and_a_missing_mission(tmp_path: Path) -> None:
     bad = tmp_path / "bad.yaml"
     bad.write_text(edit("[kitchen, hall]", "[kitchen, garage]"))
@@ -600,6 +601,7 @@ def test_schema_out_writes_the_file_atomically(
     assert not nowhere.parent.exists()
 
 
+@pytest.mark.slow
 def test_subprocess_schema_is_valid_json() -> None:
     result = run_subprocess(["mission", "schema"], cwd=ROOT)
     assert result.returncode == 0, result.stderr

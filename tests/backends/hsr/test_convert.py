@@ -20,6 +20,8 @@ from pfctl.core.robot import (
     Twist2D,
 )
 
+pytestmark = pytest.mark.ros
+
 pytestmark = pytest.mark.usefixtures("ros")
 
 

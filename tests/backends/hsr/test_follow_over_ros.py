@@ -30,6 +30,8 @@ import pytest
 
 from tests.backends.hsr.conftest import RosMaster, _stop, start_master
 
+pytestmark = [pytest.mark.ros, pytest.mark.sim, pytest.mark.slow]
+
 ROOT = Path(__file__).resolve().parents[3]
 HOUSE = ROOT / "missions" / "house.yaml"
 PFCTL = [sys.executable, "-m", "pfctl"]

@@ -13,6 +13,9 @@ import subprocess
 import time
 
 import numpy as np
+import pytest
+
+pytestmark = pytest.mark.ros
 
 NODE_TIMEOUT = 60.0
 """Wall seconds a node may take (it takes ~1-2 s here)."""

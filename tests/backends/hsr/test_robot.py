@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+pytestmark = pytest.mark.ros
+
 NODES = Path(__file__).parent / "nodes"
 WAIT = 30.0
 """Wall seconds any one expected line may take (they take ~1-3 s here)."""

@@ -38,6 +38,8 @@ from tests.backends.hsr.conftest import RosMaster, stop_node
 from tests.backends.hsr.test_master import read_line
 from tests.conftest import run_cli
 
+pytestmark = [pytest.mark.ros, pytest.mark.sim]
+
 ROOT = Path(__file__).resolve().parents[3]
 HOUSE = ROOT / "missions" / "house.yaml"
 PFCTL = str(Path(sys.executable).parent / "pfctl")

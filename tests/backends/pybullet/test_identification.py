@@ -29,6 +29,8 @@ from pfctl.core.perception.vision import (
 from pfctl.core.robot import HeadTarget, RgbdFrame
 from pfctl.mission import Mission, loads_mission
 
+pytestmark = pytest.mark.sim
+
 ROBOT = (1.0, 3.0)  # facing +x
 
 SCENE = """
@@ -77,6 +79,7 @@ def _detector(robot: SimRobot) -> MaskPersonDetector:
     )
 
 
+@pytest.mark.slow
 def test_rendered_faces_match_the_same_person_across_views_and_no_one_else() -> None:
     encoder = FaceEncoder()
     faces: dict[str, list[np.ndarray]] = {}
@@ -105,6 +108,7 @@ def test_rendered_faces_match_the_same_person_across_views_and_no_one_else() -> 
             assert cross > 0.6, (a, b)
 
 
+@pytest.mark.slow
 def test_algorithm2_picks_the_target_among_look_alikes_and_keeps_it_when_backs_turn() -> None:
     """Two people wear the target's shirt, only one has her face; the profile comes from another
     run of the simulator, where she posed alone in front of the robot."""

@@ -1,9 +1,12 @@
 """FastLaser: an empty room's walls and a person's two legs appear where they are."""
 
 import numpy as np
+import pytest
 
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec
 from pfctl.core.robot import Pose2D
+
+pytestmark = pytest.mark.sim
 
 ROOM = np.array([[-3, -3, 3, -3], [3, -3, 3, 3], [3, 3, -3, 3], [-3, 3, -3, -3]], dtype=float)
 

@@ -21,6 +21,8 @@ from pfctl.core.perception.legs.training import LegDataset, label_by_circles, sc
 from pfctl.core.robot import Pose2D
 from pfctl.mission import load_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import shapely
 
 from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
@@ -12,6 +13,8 @@ from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
 from pfctl.core.robot import NavStatus, Pose2D, Twist2D
 from pfctl.mission import Mission
+
+pytestmark = pytest.mark.sim
 
 DT = 0.1
 

@@ -15,6 +15,8 @@ from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import load_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 

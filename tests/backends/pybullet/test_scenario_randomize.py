@@ -15,6 +15,8 @@ from pfctl.core.mapping.planning import GridPlanner
 from pfctl.errors import MissionError
 from pfctl.mission import Mission, ScenarioConfig, loads_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 
@@ -37,6 +39,7 @@ def test_off_by_default(mission: Mission, planner: GridPlanner) -> None:
     )
 
 
+@pytest.mark.slow
 def test_randomize_varies_by_seed_and_keeps_the_other_draws(
     mission: Mission, planner: GridPlanner
 ) -> None:

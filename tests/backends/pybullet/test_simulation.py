@@ -13,6 +13,8 @@ from pfctl.backends.pybullet.walkers import LEG_RADIUS
 from pfctl.core.robot import HeadTarget, NavStatus, Pose2D, Robot, Twist2D
 from pfctl.mission import Mission, load_mission, loads_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 # Two rooms side by side; the wall between them at x = 6 has its door at y = 3.0..3.9.
@@ -251,6 +253,7 @@ def test_pose_noise_and_odometry_drift(two_rooms: Mission) -> None:
                 assert abs(odom.x - truth) < 0.2
 
 
+@pytest.mark.slow
 def test_same_seed_same_episode_other_seed_differs(house: Mission) -> None:
     def episode(seed: int) -> tuple:
         with SimRobot(house, SimOptions(seed=seed)) as robot:

@@ -14,6 +14,8 @@ from pfctl.core.mapping.walls import rasterize_house
 from pfctl.core.robot import NavStatus, Pose2D, Twist2D
 from pfctl.mission import Mission, load_mission, loads_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 ROOM = """

@@ -11,6 +11,8 @@ from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
 from pfctl.mission import Mission, ScenarioConfig
 
+pytestmark = pytest.mark.sim
+
 DT = 0.05
 
 

@@ -4,11 +4,14 @@ from pathlib import Path
 
 import numpy as np
 import pybullet as p
+import pytest
 
 from pfctl.backends.pybullet.laser import FastLaser
 from pfctl.backends.pybullet.world import build_world
 from pfctl.core.robot import Pose2D
 from pfctl.mission import load_mission
+
+pytestmark = pytest.mark.sim
 
 HOUSE = Path(__file__).parents[3] / "missions" / "house.yaml"
 

@@ -261,6 +261,7 @@ def _target(now: float) -> TargetState:
     return TargetState(1, 2.0, 1.0, 0.0, 0.0, now)
 
 
+@pytest.mark.sim
 def test_the_reactive_tree_follows_and_otherwise_only_stops() -> None:
     rig = TreeRig("reactive.yaml")
     assert rig.tick(0.0, _target(0.0)) == (Status.RUNNING, "follow_target")

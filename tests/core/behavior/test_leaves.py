@@ -26,6 +26,8 @@ from pfctl.core.mapping.regions import WaypointDecision
 from pfctl.core.robot import STOP, Pose2D, Twist2D
 from pfctl.mission import Mission, load_mission
 
+pytestmark = pytest.mark.sim
+
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -118,6 +119,7 @@ walls = st.lists(
 coords = st.tuples(st.floats(-1.5, 4.5), st.floats(-2.5, 2.5))  # partly outside the grid
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None)
 @given(
     rects=walls,

@@ -85,6 +85,7 @@ def test_detector_with_history_agrees_with_one_scan_on_a_still_scene() -> None:
     assert smoothed.evidence is not None and smoothed.evidence.tracks == 0
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not LEGS.is_dir(), reason=f"no real leg bags in {LEGS}")
 def test_history_raises_precision_and_recall_on_held_out_real_bags() -> None:
     """Leave one bag (one laser of negative_2) out, a small forest on the rest: averaging P(leg)
