@@ -7,10 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from pfctl.core.atomic_files import atomic_write, atomic_write_all
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import atomic_write, atomic_write_all, write_output
 
 
 def test_a_new_file_gets_the_umask_permissions_and_an_old_one_keeps_its_own(

@@ -289,7 +289,7 @@ def evaluate_command(
         results["real"] = _figures(total_b, total_a) | {"history_scans": scans}
     _out().print(table)
     if json_out is not None:
-        from pfctl.core.atomic_files import atomic_write
+        from pfctl.files import atomic_write
 
         try:
             atomic_write(json_out, json.dumps(results, indent=2) + "\n")

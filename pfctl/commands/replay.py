@@ -27,7 +27,6 @@ from rich.console import Console
 from pfctl.app.perception import build_perception
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.bags.replay import Replay, open_replay
-from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.episode import TrackRow
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.core.perception.pipeline import Perception
@@ -39,6 +38,7 @@ from pfctl.core.perception.vision import (
 )
 from pfctl.core.robot import LaserScan, RgbdFrame
 from pfctl.errors import UserError
+from pfctl.files import atomic_write_all
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 

@@ -26,7 +26,7 @@ import yaml
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import entr
 
-from pfctl.core.atomic_files import atomic_write, atomic_write_all
+from pfctl.files import atomic_write, atomic_write_all
 
 FREE = 0
 OCCUPIED = 1

@@ -17,7 +17,6 @@ from pathlib import Path
 
 import numpy as np
 
-from pfctl.core.atomic_files import atomic_write
 from pfctl.core.perception.clothes import (
     ClothesParams,
     ColorSpace,
@@ -35,6 +34,7 @@ from pfctl.core.perception.faces import (
 from pfctl.core.perception.identity.params import IdentityParams
 from pfctl.core.perception.vision import PersonDetection
 from pfctl.errors import UserError
+from pfctl.files import atomic_write
 
 #: Version of the profile file format.
 PROFILE_VERSION = 1

@@ -35,8 +35,8 @@ from typing import Any
 
 import numpy as np
 
-from pfctl.core.atomic_files import atomic_write
 from pfctl.errors import UserError
+from pfctl.files import atomic_write
 
 FORMAT = "pfctl-leg-forest"
 FORMAT_VERSION = 1
