@@ -29,7 +29,7 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from typer.core import TyperGroup
 
-from pfctl.core.mapping.grid import GridFileError, OccupancyGrid
+from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.regions import RegionMap
 from pfctl.core.mapping.walls import rasterize_house
@@ -48,6 +48,7 @@ from pfctl.core.prediction.tracks import Track, TrajectoryFileError, read_csv_tr
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission
+from pfctl.mission.map_server import GridFileError, load_map_server
 from pfctl.progress import progress_bar
 
 
@@ -185,7 +186,7 @@ def _map_of(mission: Mission) -> tuple[OccupancyGrid, HouseLayout, RegionMap]:
     layout = mission.layout()
     if mission.map.occupancy is not None:
         try:
-            grid = OccupancyGrid.load_map_server(mission.map.occupancy)
+            grid = load_map_server(mission.map.occupancy)
         except GridFileError as err:
             raise UserError(str(err)) from None
     else:
