@@ -12,6 +12,7 @@ from typing import Literal
 
 from numpy.typing import ArrayLike
 
+from pfctl.app.profiles import check_target_profile
 from pfctl.core.mapping.grid import GridGeometry
 from pfctl.core.perception.belief import BeliefParams, HumanBelief
 from pfctl.core.perception.clothes import ClothesParams
@@ -104,6 +105,7 @@ def build_perception(
     identifier = None
     if profile is not None:
         params = identity_params(mission, robot, face_timing)
+        check_target_profile(profile, params)
         worker: FaceWorker | None = None
         if isinstance(face_worker, FaceWorker):
             worker = face_worker
