@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 from pfctl.app.leg_data import real_sequences, sequences_dataset
-from pfctl.core.perception.legs.detector import LegDetector, LegParams, load_leg_model
+from pfctl.app.leg_models import load_leg_model
+from pfctl.core.perception.legs.detector import LegDetector, LegParams
 from pfctl.core.perception.legs.evidence import LegEvidence
 from pfctl.core.perception.legs.training import Score, evaluate_sequence, train_forest
 from pfctl.core.robot import LaserScan, Pose2D
