@@ -77,7 +77,7 @@ def test_corrupt_model_exits_2(
 @pytest.mark.xfail(
     strict=True,
     reason="goal not met yet: on positive_2 + negative_2 (both in its training data) the shipped "
-    "model has recall ~0.83, precision ~0.50 at 0.5-5 m (pfctl issue 5)",
+    "model's recall and precision at 0.5-5 m stay below 0.9 (benchmarks/leg_real_ceiling.py)",
 )
 def test_shipped_model_on_a_real_bag(tmp_path: Path) -> None:
     """The shipped model (trained on sim + every real bag) on one positive bag and the

@@ -45,7 +45,7 @@ def test_cv_is_exact_on_straight_tracks_and_others_close() -> None:
     w = make_windows([_straight(30, (1.2, -0.3), "a")], 8, 12)
     scores = evaluate([ModelSpec.of(n) for n in ("cv", "poly3", "svr")], w)
     assert scores["cv"].ade < 1e-9 and scores["poly3"].ade < 1e-6
-    assert scores["svr"].ade < 0.3  # the regularised end slope: ~5 % slower (see prediction.py)
+    assert scores["svr"].ade < 0.3  # the regularised end slope lags (core/prediction/models.py)
     for s in scores.values():
         assert s.n == len(w) and s.ms_per_call > 0
         assert s.fde >= s.ade - 1e-12  # straight: error grows with the horizon
