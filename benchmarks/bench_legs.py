@@ -29,6 +29,7 @@ from typing import Any  # noqa: E402
 
 import numpy as np  # noqa: E402
 
+from pfctl.app.leg_models import load_leg_model  # noqa: E402
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec  # noqa: E402
 from pfctl.backends.pybullet.leg_scans import LegScanGenerator  # noqa: E402
 from pfctl.backends.pybullet.walkers import HIP_WIDTH, LEG_RADIUS  # noqa: E402
@@ -36,7 +37,6 @@ from pfctl.core.perception.legs.detector import (  # noqa: E402
     LegDetector,
     LegParams,
     describe_segments,
-    load_leg_model,
 )
 from pfctl.core.perception.legs.features import segment_features, segment_scan  # noqa: E402
 from pfctl.core.robot import LaserScan, Pose2D  # noqa: E402

@@ -1,12 +1,28 @@
-"""Writing the files a command produces: atomically, and with a one-line error for the user."""
+"""Writing files all or nothing: a temporary file beside the target, then ``os.replace``.
+
+Nothing partial is ever left behind (house rule): on any error the temporaries are removed and
+the targets keep their old content. An existing target keeps its permission bits; a new one gets
+the usual ``0o666 & ~umask`` (not ``mkstemp``'s private 0o600). :func:`write_output` is the same
+for the files a command produces, with a one-line error for the user.
+"""
 
 from __future__ import annotations
 
+import contextlib
 import os
+import tempfile
+from collections.abc import Sequence
 from pathlib import Path
 
-from pfctl.core.atomic_files import atomic_write
 from pfctl.errors import UserError
+
+__all__ = ["atomic_write", "atomic_write_all", "write_output"]
+
+
+def atomic_write(path: str | os.PathLike[str], data: str | bytes) -> Path:
+    """Write ``data`` (str as UTF-8) to ``path`` atomically; return the path. Raises OSError."""
+    atomic_write_all([(path, data)])
+    return Path(path)
 
 
 def write_output(path: str | os.PathLike[str], data: str | bytes) -> Path:
@@ -16,3 +32,43 @@ def write_output(path: str | os.PathLike[str], data: str | bytes) -> Path:
         return atomic_write(path, data)
     except OSError as err:
         raise UserError(f"{path}: cannot write: {err.strerror or err}") from None
+
+
+def atomic_write_all(files: Sequence[tuple[str | os.PathLike[str], str | bytes]]) -> None:
+    """Write several files so that none is replaced unless all were written (e.g. a map's YAML
+    and its PGM). The final renames run in order; each one is atomic. Raises OSError."""
+    temporaries: list[tuple[str, Path]] = []
+    try:
+        for path, data in files:
+            target = Path(path)
+            temporaries.append((_write_temporary(target, data), target))
+        while temporaries:
+            tmp, target = temporaries[0]
+            os.replace(tmp, target)
+            temporaries.pop(0)
+    finally:
+        for tmp, _ in temporaries:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
+def _write_temporary(target: Path, data: str | bytes) -> str:
+    payload = data.encode("utf-8") if isinstance(data, str) else data
+    try:
+        mode = target.stat().st_mode & 0o7777
+    except OSError:
+        umask = os.umask(0)
+        os.umask(umask)
+        mode = 0o666 & ~umask
+    fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as handle:
+            handle.write(payload)
+            handle.flush()
+            os.fsync(handle.fileno())
+        os.chmod(tmp, mode)
+    except BaseException:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        raise
+    return tmp

@@ -7,10 +7,10 @@ from pathlib import Path
 
 import pytest
 
-from pfctl.core.atomic_files import atomic_write, atomic_write_all
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import atomic_write, atomic_write_all, write_output
+from pfctl.mission.map_server import save_map_server
 
 
 def test_a_new_file_gets_the_umask_permissions_and_an_old_one_keeps_its_own(
@@ -42,7 +42,7 @@ def test_when_one_file_cannot_be_written_none_is_replaced(tmp_path: Path) -> Non
 def test_saved_maps_are_readable_by_others(tmp_path: Path) -> None:
     umask = os.umask(0o022)
     try:
-        yaml_file, pgm_file = OccupancyGrid.empty(1.0, 1.0, 0.1).save_map_server(tmp_path / "m")
+        yaml_file, pgm_file = save_map_server(OccupancyGrid.empty(1.0, 1.0, 0.1), tmp_path / "m")
     finally:
         os.umask(umask)
     assert yaml_file.stat().st_mode & 0o777 == 0o644

@@ -21,6 +21,7 @@ from rich.progress import BarColumn, Progress, TextColumn
 
 from pfctl.app.follower import EpisodeResult, build_follower, run_follower, static_map
 from pfctl.app.perception import build_perception, identity_params
+from pfctl.app.profiles import check_target_profile, load_target_profile
 from pfctl.core.episode import EpisodeLog, TickRecord
 from pfctl.core.mapping.grid import FREE
 from pfctl.core.metrics import MetricParams, search_metrics
@@ -47,8 +48,8 @@ def target_profile(
     params = identity_params(mission)
     if path is not None:
         try:
-            profile = TargetProfile.load(path)
-            profile.check_params(params, str(path))
+            profile = load_target_profile(path)
+            check_target_profile(profile, params, str(path))
         except (OSError, ValueError) as err:
             raise UserError(f"--target {path}: {err}") from None
         return profile

@@ -23,6 +23,7 @@ from pfctl.core.mapping.walls import rasterize_house
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.robot import STOP, GroundTruth, Robot, RobotLostError
 from pfctl.mission import Mission
+from pfctl.mission.map_server import load_map_server
 
 
 def control_params(mission: Mission) -> ControlParams:
@@ -75,7 +76,7 @@ def follower_params(mission: Mission) -> FollowerParams:
 def static_map(mission: Mission) -> OccupancyGrid:
     """The house's walls and furniture as the robot's navigation map."""
     if mission.map.occupancy is not None:
-        return OccupancyGrid.load_map_server(mission.map.occupancy)
+        return load_map_server(mission.map.occupancy)
     return rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
 
 

@@ -5,9 +5,8 @@ is ~50 000 pixels, so ~1.2 MB per ``(n, 3)`` float array of their 3-D points, an
 grid and the belief add more of a few hundred kB. glibc serves blocks above its mmap threshold
 (128 kB at start, adjusted upwards as blocks are freed, at most 32 MiB) with a fresh ``mmap`` and
 hands them back with ``munmap`` when freed, and trims the top of its heap beyond 128 kB: the next
-tick's arrays then touch new pages, one page fault per 4 kB. On the 2-vCPU VM the benchmarks run
-on (a Firecracker guest) a fault costs several µs: the crowd episode's perception took ~135
-faults per tick, a 50 000-pixel person's back-projection 5 ms instead of 0.8 ms.
+tick's arrays then touch new pages, one page fault per 4 kB, and on a virtual machine a fault is
+expensive (benchmarks/README.md, ``replay_tick_stages.py``, has the figures).
 
 :func:`retain_freed_memory` sets the mmap threshold to glibc's maximum (32 MiB on 64 bits: larger
 blocks are still mapped) and the trim threshold high, so freed blocks stay in the heap and the

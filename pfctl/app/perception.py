@@ -12,6 +12,8 @@ from typing import Literal
 
 from numpy.typing import ArrayLike
 
+from pfctl.app.leg_models import load_leg_model
+from pfctl.app.profiles import check_target_profile
 from pfctl.core.mapping.grid import GridGeometry
 from pfctl.core.perception.belief import BeliefParams, HumanBelief
 from pfctl.core.perception.clothes import ClothesParams
@@ -19,7 +21,7 @@ from pfctl.core.perception.face_worker import FaceWorker
 from pfctl.core.perception.identity.identifier import TargetIdentifier
 from pfctl.core.perception.identity.params import FaceTiming, IdentityParams
 from pfctl.core.perception.identity.profile import TargetProfile
-from pfctl.core.perception.legs.detector import LegDetector, LegParams, load_leg_model
+from pfctl.core.perception.legs.detector import LegDetector, LegParams
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.perception.tracking import MultiPersonTracker, TrackerParams
 from pfctl.core.perception.vision import PersonDetector
@@ -104,6 +106,7 @@ def build_perception(
     identifier = None
     if profile is not None:
         params = identity_params(mission, robot, face_timing)
+        check_target_profile(profile, params)
         worker: FaceWorker | None = None
         if isinstance(face_worker, FaceWorker):
             worker = face_worker

@@ -19,7 +19,6 @@ does have) or a topic of another message type.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from pfctl.core.robot import LaserScan, Pose2D
+from pfctl.core.tf_buffer import yaw_from_quaternion
 from pfctl.errors import UserError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
@@ -68,10 +68,6 @@ def stamp_seconds(header: Any) -> float:
     return float(header.stamp.sec) + float(header.stamp.nanosec) * 1e-9
 
 
-def _yaw(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 def laser_scan(msg: Any) -> tuple[str, LaserScan]:
     """A deserialised ``sensor_msgs/LaserScan`` as ``(frame_id, LaserScan)`` in its own frame."""
     r = np.array(msg.ranges, dtype=float)
@@ -93,9 +89,11 @@ def laser_scan(msg: Any) -> tuple[str, LaserScan]:
 
 def pose_array(msg: Any) -> PoseArrayMessage:
     """A deserialised ``geometry_msgs/PoseArray`` as :class:`PoseArrayMessage`."""
-    poses = np.array(
-        [(p.position.x, p.position.y, _yaw(p.orientation)) for p in msg.poses], dtype=float
-    ).reshape(-1, 3)
+    rows = []
+    for p in msg.poses:
+        q = p.orientation
+        rows.append((p.position.x, p.position.y, yaw_from_quaternion(q.x, q.y, q.z, q.w)))
+    poses = np.array(rows, dtype=float).reshape(-1, 3)
     return PoseArrayMessage(stamp_seconds(msg.header), str(msg.header.frame_id), poses)
 
 

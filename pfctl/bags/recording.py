@@ -70,6 +70,7 @@ from pfctl.core.robot import (
     RgbdFrame,
     Twist2D,
 )
+from pfctl.core.tf_buffer import quaternion_from_yaw, yaw_from_quaternion
 
 BAG_NAME = "episode.bag"
 TRUTH_NAME = "truth.csv"
@@ -262,23 +263,21 @@ class EpisodeRecorder:
 
     def _pose(self, p: Pose2D, z: float = 0.0) -> Any:
         t = self._types()
+        qx, qy, qz, qw = quaternion_from_yaw(p.theta)
         return t["geometry_msgs/msg/Pose"](
             position=t["geometry_msgs/msg/Point"](x=float(p.x), y=float(p.y), z=z),
-            orientation=t["geometry_msgs/msg/Quaternion"](
-                x=0.0, y=0.0, z=math.sin(p.theta / 2.0), w=math.cos(p.theta / 2.0)
-            ),
+            orientation=t["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw),
         )
 
     def _transform(self, stamp: float, parent: str, child: str, p: Pose2D, z: float) -> Any:
         t = self._types()
+        qx, qy, qz, qw = quaternion_from_yaw(p.theta)
         return t["geometry_msgs/msg/TransformStamped"](
             header=self._header(stamp, parent),
             child_frame_id=child,
             transform=t["geometry_msgs/msg/Transform"](
                 translation=t["geometry_msgs/msg/Vector3"](x=float(p.x), y=float(p.y), z=z),
-                rotation=t["geometry_msgs/msg/Quaternion"](
-                    x=0.0, y=0.0, z=math.sin(p.theta / 2.0), w=math.cos(p.theta / 2.0)
-                ),
+                rotation=t["geometry_msgs/msg/Quaternion"](x=qx, y=qy, z=qz, w=qw),
             ),
         )
 
@@ -616,17 +615,19 @@ class Episode:
         return {k: np.array(v).reshape(-1, 2) for k, v in out.items()}
 
 
-def _yaw(q: Any) -> float:
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
-
-
 def _pose2d(pose: Any) -> Pose2D:
-    return Pose2D(float(pose.position.x), float(pose.position.y), _yaw(pose.orientation))
+    q = pose.orientation
+    return Pose2D(
+        float(pose.position.x), float(pose.position.y), yaw_from_quaternion(q.x, q.y, q.z, q.w)
+    )
 
 
 def _tf_pose(tr: Any) -> Pose2D:
     t = tr.transform
-    return Pose2D(float(t.translation.x), float(t.translation.y), _yaw(t.rotation))
+    q = t.rotation
+    return Pose2D(
+        float(t.translation.x), float(t.translation.y), yaw_from_quaternion(q.x, q.y, q.z, q.w)
+    )
 
 
 def _stamp(header: Any) -> float:

@@ -22,8 +22,8 @@ from pathlib import Path
 from typing import IO, Any
 
 from pfctl.bench.plan import Campaign
-from pfctl.core.atomic_files import atomic_write
 from pfctl.errors import UserError
+from pfctl.files import atomic_write
 
 __all__ = [
     "CAMPAIGN_FILE",

@@ -52,7 +52,6 @@ from pfctl.app.episodes import (
 )
 from pfctl.app.follower import EpisodeResult
 from pfctl.commands.replay import tracks_csv
-from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.metrics import (
     FollowMetrics,
     SearchMetrics,
@@ -62,6 +61,7 @@ from pfctl.core.metrics import (
 from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
+from pfctl.files import atomic_write_all
 from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission
 

@@ -44,7 +44,6 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn
 
 from pfctl.app.perception import identity_params
-from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.faces import FaceEncoder
 from pfctl.core.perception.identity.params import IdentityParams
@@ -62,6 +61,7 @@ from pfctl.core.perception.vision import (
 )
 from pfctl.core.robot import STOP, HeadTarget, Pose2D, RgbdFrame, Robot, RobotLostError
 from pfctl.errors import UserError
+from pfctl.files import atomic_write_all
 from pfctl.mission import Mission, load_mission
 
 if TYPE_CHECKING:

@@ -26,6 +26,7 @@ import typer
 from rich.console import Console
 from rich.table import Table
 
+from pfctl import __version__
 from pfctl.app.leg_data import (
     ScanSequence,
     count_real_scans,
@@ -33,8 +34,9 @@ from pfctl.app.leg_data import (
     sequences_dataset,
     sim_dataset,
 )
+from pfctl.app.leg_models import load_leg_model, save_leg_model
 from pfctl.app.perception import leg_params
-from pfctl.core.perception.legs.detector import LegParams, load_leg_model
+from pfctl.core.perception.legs.detector import LegParams
 from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.perception.legs.training import (
     EVAL_BAND,
@@ -142,6 +144,7 @@ def train_command(
     if data.positives == 0 or data.positives == len(data):
         raise UserError("the training data has only one class (no legs, or nothing but legs)")
     meta = {
+        "pfctl_version": __version__,
         "datasets": [
             {
                 "name": p.name,
@@ -168,7 +171,7 @@ def train_command(
         model = train_forest(data, seed, metadata=meta)
         advance(1)
     try:
-        model.save(out)
+        save_leg_model(model, out)
     except OSError as err:
         raise UserError(f"--out {out}: cannot write: {err.strerror}") from None
     in_band, everywhere = evaluate_model(model, data, params.probability)
@@ -289,7 +292,7 @@ def evaluate_command(
         results["real"] = _figures(total_b, total_a) | {"history_scans": scans}
     _out().print(table)
     if json_out is not None:
-        from pfctl.core.atomic_files import atomic_write
+        from pfctl.files import atomic_write
 
         try:
             atomic_write(json_out, json.dumps(results, indent=2) + "\n")

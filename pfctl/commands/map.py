@@ -28,7 +28,7 @@ from rich.console import Console
 from rich.table import Table
 from shapely.geometry import Polygon
 
-from pfctl.core.mapping.grid import GridFileError, OccupancyGrid
+from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import Door, HouseLayout, Region
 from pfctl.core.mapping.rooms import RoomParams, name_after, segment_rooms
 from pfctl.core.mapping.walls import rasterize_house
@@ -36,6 +36,7 @@ from pfctl.errors import MissionError, UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission, loads_mission
 from pfctl.mission.edit import render_regions
+from pfctl.mission.map_server import GridFileError, load_map_server, save_map_server
 
 app = typer.Typer(help="Maps: annotate regions and doors, render them.", no_args_is_help=True)
 
@@ -82,7 +83,7 @@ def _read_yaml_mapping(path: Path, what: str) -> dict[str, Any]:
 
 def _load_map_server(path: Path) -> OccupancyGrid:
     try:
-        return OccupancyGrid.load_map_server(path)
+        return load_map_server(path)
     except GridFileError as err:
         raise UserError(str(err)) from None
 
@@ -499,7 +500,7 @@ def export(
     )
     _prepare_parent(out, "--out")
     try:
-        yaml_path, pgm_path = grid.save_map_server(out)
+        yaml_path, pgm_path = save_map_server(grid, out)
     except GridFileError as err:
         raise UserError(str(err)) from None
     g = grid.geometry

@@ -29,7 +29,8 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from typer.core import TyperGroup
 
-from pfctl.core.mapping.grid import GridFileError, OccupancyGrid
+from pfctl.app.trajectory_files import read_csv_trajectory, read_trajectories
+from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.regions import RegionMap
 from pfctl.core.mapping.walls import rasterize_house
@@ -44,10 +45,11 @@ from pfctl.core.prediction.models import (
     make_model,
 )
 from pfctl.core.prediction.search import grid_search
-from pfctl.core.prediction.tracks import Track, TrajectoryFileError, read_csv_track, read_tracks
+from pfctl.core.prediction.trajectories import Trajectory
 from pfctl.errors import UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission
+from pfctl.mission.map_server import GridFileError, load_map_server
 from pfctl.progress import progress_bar
 
 
@@ -160,17 +162,14 @@ def _prepare_output(path: Path | None, option: str) -> None:
 
 def _load_tracks(
     data: Path, fmt: InFormat, fps: float | None, frame_step: float | None
-) -> list[Track]:
+) -> list[Trajectory]:
     if fmt is InFormat.frames and fps is None:
         raise UserError("--fps: required with --format frames (annotated steps per second)")
     if fmt is InFormat.csv and (fps is not None or frame_step is not None):
         raise UserError("--fps/--frame-step: only for --format frames; CSV times are seconds")
     _positive(fps, "--fps", "steps per second")
     _positive(frame_step, "--frame-step", "frame ids")
-    try:
-        return read_tracks(data, fmt.value, fps=fps, frame_step=frame_step)
-    except TrajectoryFileError as err:
-        raise UserError(str(err)) from None
+    return read_trajectories(data, fmt.value, fps=fps, frame_step=frame_step)
 
 
 def _json_text(data: Any) -> str:
@@ -185,7 +184,7 @@ def _map_of(mission: Mission) -> tuple[OccupancyGrid, HouseLayout, RegionMap]:
     layout = mission.layout()
     if mission.map.occupancy is not None:
         try:
-            grid = OccupancyGrid.load_map_server(mission.map.occupancy)
+            grid = load_map_server(mission.map.occupancy)
         except GridFileError as err:
             raise UserError(str(err)) from None
     else:
@@ -196,7 +195,7 @@ def _map_of(mission: Mission) -> tuple[OccupancyGrid, HouseLayout, RegionMap]:
 
 
 def _fit_predict(
-    name: str, history: Track, times: np.ndarray, params: dict[str, Any], where: str
+    name: str, history: Trajectory, times: np.ndarray, params: dict[str, Any], where: str
 ) -> np.ndarray:
     if len(history) < MIN_POINTS[name]:
         raise UserError(
@@ -282,10 +281,7 @@ def track(
     history_s = history_s or (mission.prediction.history_s if mission is not None else 3.0)
     _prepare_output(out, "--out")
     _prepare_output(plot, "--plot")
-    try:
-        full = read_csv_track(track_file, min_points=2)
-    except TrajectoryFileError as err:
-        raise UserError(str(err)) from None
+    full = read_csv_trajectory(track_file, min_points=2)
     history = full.last(history_s)
     dt = step or float(np.median(np.diff(full.t)))
     n = max(1, math.ceil(horizon / dt - 1e-9))
@@ -355,8 +351,8 @@ def track(
 
 
 def _track_plot(
-    full: Track,
-    history: Track,
+    full: Trajectory,
+    history: Trajectory,
     times: np.ndarray,
     mission: Mission | None,
     grid: OccupancyGrid | None,
@@ -574,7 +570,7 @@ def search_command(
     if not 0.0 < test_fraction < 1.0:
         raise UserError(f"--test-fraction: expected a number in (0, 1), got {test_fraction:g}")
     _prepare_output(json_out, "--json")
-    scenes: dict[str, list[Track]] = {}
+    scenes: dict[str, list[Trajectory]] = {}
     for path in data:
         name = path.name or str(path)
         if name in scenes:

@@ -25,11 +25,10 @@ import typer
 from rich.console import Console
 
 from pfctl.app.perception import build_perception
+from pfctl.app.profiles import load_target_profile
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.bags.replay import Replay, open_replay
-from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.episode import TrackRow
-from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.perception.vision import (
     GivenPersonDetector,
@@ -39,6 +38,7 @@ from pfctl.core.perception.vision import (
 )
 from pfctl.core.robot import LaserScan, RgbdFrame
 from pfctl.errors import UserError
+from pfctl.files import atomic_write_all
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 
@@ -90,7 +90,7 @@ def replay(
     """Run leg detection, tracking (and vision + identification) on a recorded bag."""
     console = Console(stderr=True)
     mission = _mission(mission_path)
-    profile = TargetProfile.load(target) if target is not None else None
+    profile = load_target_profile(target) if target is not None else None
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: exists and is not a folder")
     source = open_replay(bag, scan_topic=scan_topic, frame=frame, camera=camera)

@@ -30,12 +30,12 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-from pfctl.core.mapping.grid import GridFileError
 from pfctl.core.mapping.planning import NoPathError
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
+from pfctl.mission.map_server import GridFileError, save_map_server
 
 if TYPE_CHECKING:  # the simulator is imported when a command needs it: pybullet loads slowly
     from pfctl.backends.hsr.sim_bridge import BridgeStats
@@ -269,7 +269,7 @@ def export_map(
     )
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        yaml_path, pgm_path = grid.save_map_server(out)
+        yaml_path, pgm_path = save_map_server(grid, out)
     except OSError as err:
         raise UserError(f"--out {out}: cannot create its folder: {err.strerror}") from None
     except GridFileError as err:

@@ -39,6 +39,17 @@ def quaternion_matrix(x: float, y: float, z: float, w: float) -> np.ndarray:
     )
 
 
+def yaw_from_quaternion(x: float, y: float, z: float, w: float) -> float:
+    """The yaw (rad, about z; ZYX convention) of a unit quaternion ``(x, y, z, w)``:
+    ``atan2(2(wz + xy), 1 − 2(y² + z²))``."""
+    return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
+
+
+def quaternion_from_yaw(yaw: float) -> tuple[float, float, float, float]:
+    """The unit quaternion ``(x, y, z, w)`` of a rotation by ``yaw`` (rad) about z."""
+    return (0.0, 0.0, math.sin(yaw / 2.0), math.cos(yaw / 2.0))
+
+
 def _slerp(q0: np.ndarray, q1: np.ndarray, s: float) -> np.ndarray:
     dot = float(np.dot(q0, q1))
     if dot < 0.0:  # the shorter way round
@@ -163,4 +174,10 @@ class TransformBuffer:
         return Pose2D(float(m[0, 3]), float(m[1, 3]), math.atan2(m[1, 0], m[0, 0]))
 
 
-__all__ = ["TransformBuffer", "TransformLookupError", "quaternion_matrix"]
+__all__ = [
+    "TransformBuffer",
+    "TransformLookupError",
+    "quaternion_from_yaw",
+    "quaternion_matrix",
+    "yaw_from_quaternion",
+]

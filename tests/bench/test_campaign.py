@@ -1,7 +1,7 @@
-"""pfctl bench end to end (issue 8): a 4-episode campaign with 2 worker processes, interrupted
+"""pfctl bench end to end: a 4-episode campaign with 2 worker processes, interrupted
 with Ctrl-C and resumed, and the same campaign as Ray tasks (Ray started locally): the same
 seeds give the same per-episode metrics, and the resumed campaign ran only what had not
-finished. Short episodes (15 s simulated) keep this to a few minutes on 2 cores."""
+finished. Short episodes (15 s simulated) keep it short."""
 
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ pytestmark = [pytest.mark.sim, pytest.mark.slow]
 
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 ARGS = ["--episodes", "4", "--seed", "3", "--duration", "15", "--workers", "2"]
-#: Wall seconds any one command may take (4 short episodes on a busy 2-core machine: ~2 min).
+#: Wall seconds any one command may take (4 short episodes, generously, for a busy machine).
 TIMEOUT = 900
 
 

@@ -12,10 +12,11 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.app.perception import identity_params
+from pfctl.app.profiles import load_target_profile
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.commands.learn_target import learn_from_images
 from pfctl.core.perception.clothes import histogram_intersection
-from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
+from pfctl.core.perception.identity.profile import learn_profile
 from pfctl.core.perception.vision import MaskPersonDetector
 from pfctl.core.robot import HeadTarget
 from pfctl.errors import UserError
@@ -51,7 +52,7 @@ def test_learn_target_in_the_simulated_house(tmp_path, capsys, monkeypatch) -> N
         [*args, "--seconds", "3", "--plot", str(png)], capsys, monkeypatch
     )
     assert code == 0, stderr
-    profile = TargetProfile.load(out)
+    profile = load_target_profile(out)
     assert len(profile.faces) > 0 and profile.frames > 10
     mission = load_mission(HOUSE)
     assert profile.color_space == mission.perception.identity.color_space
@@ -104,7 +105,7 @@ def test_learn_target_from_a_folder_of_pictures(pictures, tmp_path, capsys, monk
         monkeypatch,
     )
     assert code == 0, stderr
-    profile = TargetProfile.load(out)
+    profile = load_target_profile(out)
     assert profile.frames == 3 and len(profile.faces) >= 1
     assert "learned from 3 of 3 frames" in stdout
 
@@ -126,7 +127,7 @@ def test_learn_target_from_a_video(pictures, tmp_path, capsys, monkeypatch) -> N
     code, stdout, stderr = run_cli(args, capsys, monkeypatch)
     assert code == 0, stderr
     assert "learned from 9 of 9 frames" in stdout
-    assert len(TargetProfile.load(out).faces) >= 1
+    assert len(load_target_profile(out).faces) >= 1
 
 
 def test_several_people_need_pick_which_takes_the_nth_from_the_left(pictures) -> None:

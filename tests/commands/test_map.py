@@ -14,12 +14,12 @@ import pytest
 from shapely.geometry import Polygon
 
 from pfctl.cli import main
-from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import Door, Region
 from pfctl.core.mapping.rooms import polygon_iou
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import load_mission
 from pfctl.mission.edit import write_regions
+from pfctl.mission.map_server import load_map_server
 
 ROOT = Path(__file__).resolve().parents[2]
 HOUSE = ROOT / "missions" / "house.yaml"
@@ -108,7 +108,7 @@ def test_auto_annotation_of_the_exported_house_finds_every_room(house_map, tmp_p
 
 
 def test_export_writes_the_rasterised_house(house_map) -> None:
-    loaded = OccupancyGrid.load_map_server(house_map)
+    loaded = load_map_server(house_map)
     expected = rasterize_house(load_mission(HOUSE).layout(), 0.05)
     assert loaded.geometry == expected.geometry
     assert np.array_equal(loaded.states(), expected.states())

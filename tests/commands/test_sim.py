@@ -9,9 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import load_mission
+from pfctl.mission.map_server import load_map_server
 
 pytestmark = pytest.mark.sim
 
@@ -27,7 +27,7 @@ def test_export_map_round_trips(tmp_path: Path) -> None:
     out = tmp_path / "maps" / "house.yaml"
     res = _pfctl("sim", "export-map", str(HOUSE), "--out", str(out))
     assert res.returncode == 0, res.stderr
-    loaded = OccupancyGrid.load_map_server(out)
+    loaded = load_map_server(out)
     mission = load_mission(HOUSE)
     expected = rasterize_house(
         mission.layout(), mission.map.resolution, wall_thickness=mission.map.wall_thickness

@@ -8,19 +8,21 @@ import numpy as np
 import pytest
 
 from pfctl.core.robot import Pose2D
-from pfctl.core.tf_buffer import TransformBuffer, TransformLookupError
-
-
-def _yaw_q(yaw: float) -> tuple[float, float, float, float]:
-    return (0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2))
+from pfctl.core.tf_buffer import (
+    TransformBuffer,
+    TransformLookupError,
+    quaternion_from_yaw,
+    quaternion_matrix,
+    yaw_from_quaternion,
+)
 
 
 def _buffer() -> TransformBuffer:
     tf = TransformBuffer()
     for t, x in ((0.0, 0.0), (1.0, 1.0)):  # odom → base drives 1 m along x in 1 s
-        tf.add("odom", "base", t, (x, 0.0, 0.0), _yaw_q(0.5 * t))
-        tf.add("map", "odom", t, (2.0, 3.0, 0.0), _yaw_q(math.pi / 2))
-    tf.add("base", "laser", 0.0, (0.2, 0.0, 0.3), _yaw_q(0.0), static=True)
+        tf.add("odom", "base", t, (x, 0.0, 0.0), quaternion_from_yaw(0.5 * t))
+        tf.add("map", "odom", t, (2.0, 3.0, 0.0), quaternion_from_yaw(math.pi / 2))
+    tf.add("base", "laser", 0.0, (0.2, 0.0, 0.3), quaternion_from_yaw(0.0), static=True)
     return tf
 
 
@@ -55,3 +57,11 @@ def test_refuses_to_extrapolate_or_join_unconnected_frames() -> None:
     tf.add("world", "camera", 0.0, (0, 0, 0), (0, 0, 0, 1))
     with pytest.raises(TransformLookupError, match="not connected"):
         tf.lookup("map", "camera", 0.0)
+
+
+@pytest.mark.parametrize("yaw", [0.0, 0.3, -2.0, math.pi - 1e-9])
+def test_yaw_and_quaternion_round_trip(yaw: float) -> None:
+    x, y, z, w = quaternion_from_yaw(yaw)
+    assert yaw_from_quaternion(x, y, z, w) == pytest.approx(yaw)
+    c, s = math.cos(yaw), math.sin(yaw)
+    assert np.allclose(quaternion_matrix(x, y, z, w)[:2, :2], [[c, -s], [s, c]])

@@ -21,7 +21,6 @@ people do not collide among themselves; they are solid for the robot, the laser
 from __future__ import annotations
 
 import functools
-import math
 import struct
 import tempfile
 import zlib
@@ -31,6 +30,7 @@ import numpy as np
 import pybullet as p
 
 from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker
+from pfctl.core.tf_buffer import quaternion_from_yaw
 
 #: Leg length as a fraction of body height (hip height).
 LEG_FRACTION = 0.47
@@ -170,10 +170,6 @@ def box_mesh(
     return vertices, indices, uvs, normals
 
 
-def _yaw(theta: float) -> tuple[float, float, float, float]:
-    return (0.0, 0.0, math.sin(theta / 2.0), math.cos(theta / 2.0))
-
-
 class PeopleBodies:
     """The bodies of ``walkers`` in the PyBullet world ``client``; :meth:`sync` moves them."""
 
@@ -281,7 +277,7 @@ class PeopleBodies:
             legs, torso, head = self._parts[walker.name]
             state = walker.state
             leg_len = LEG_FRACTION * state.height
-            q = _yaw(state.theta)
+            q = quaternion_from_yaw(state.theta)
             for body, (x, y, _r) in zip(legs, state.legs, strict=True):
                 p.resetBasePositionAndOrientation(
                     body, (float(x), float(y), leg_len / 2), q, physicsClientId=self.client

@@ -62,6 +62,7 @@ if TYPE_CHECKING:
 __all__ = [
     "FrontierCluster",
     "closest_point",
+    "cluster_utilities",
     "find_frontiers",
     "frontier_map",
     "frontiers_from_states",
@@ -256,15 +257,34 @@ def utility(
     term is dropped (pure exploration).
     """
     xa = np.asarray(x, dtype=float)
+    d_cl: list[float] | None = None
     if l_star is None:
         c = closest_point(cluster, xa)
-        d_cl = 0.0
     else:
         la = np.asarray(l_star, dtype=float)
         c = closest_point(cluster, la)
-        d_cl = _eval(distance_to_l_star, c, la)
-    d_xc = _eval(distance_from_robot, c, xa)
-    return float(alpha * cluster.n_unknown - (d_xc + d_cl))
+        d_cl = [_eval(distance_to_l_star, c, la)]
+    d_xc = [_eval(distance_from_robot, c, xa)]
+    return float(cluster_utilities([cluster.n_unknown], d_xc, d_cl, alpha)[0])
+
+
+def cluster_utilities(
+    n_unknown: ArrayLike,
+    from_robot: ArrayLike,
+    to_l_star: ArrayLike | None,
+    alpha: float,
+) -> NDArray[np.float64]:
+    """**Eq. 3** for several clusters at once: U = α·N − (d(x, c) + d(c, l*)).
+
+    ``n_unknown`` is each cluster's N, ``from_robot`` d(x, c) and ``to_l_star`` d(c, l*) of its
+    goal c (None: no heading region, the term is dropped). The one implementation of Eq. 3:
+    Algorithm 1 (:func:`pfctl.core.mapping.regions.waypoint_search`) scores all clusters with it,
+    :func:`utility` one cluster.
+    """
+    cost = np.asarray(from_robot, dtype=float)
+    if to_l_star is not None:
+        cost = cost + np.asarray(to_l_star, dtype=float)
+    return alpha * np.asarray(n_unknown, dtype=float) - cost
 
 
 def _eval(fn: DistanceFn | None, point: NDArray[np.float64], other: NDArray[np.float64]) -> float:

@@ -14,19 +14,19 @@ OCCUPIED) — free *and unknown* — because exploration has to plan through spa
 (the frontier it heads for borders unknown space, and the heading region l* may be entirely
 unknown). ``unknown_traversable=False`` restricts paths to known-free cells.
 
-Speed: a Dijkstra over all 160 000 cells of a 20 m × 20 m map at 0.05 m costs ~90 ms, so the
-paths are searched on a **coarser grid** of ``downsample`` × ``downsample`` fine cells per coarse
-cell (default: the factor giving cells closest to ``COARSE_RESOLUTION`` = 0.2 m, i.e. 4 at
-0.05 m: ~3 ms for two fields over 20 m × 20 m on one core; ``downsample=1`` searches the fine
-grid itself). The coarsening is conservative: a coarse cell is blocked as soon as any of its fine
-cells is blocked, so walls never leak; openings narrower than about two coarse cells may close
-(the doors of a house are ~0.9 m wide), and paths keep up to a coarse cell from walls, so they
-come out a little longer than on the fine grid. Diagonal steps may not cut the corner of a
-blocked cell. The exact end points are joined to the coarse grid by straight segments to the
-centres of the 3 × 3 coarse cells around them, each kept only when its line of sight is free on
-the fine grid — so a robot standing in a coarse cell that a nearby wall blocks still gets a path,
-and no shortcut crosses a wall. On the fine grid (``downsample=1``) a path length lies between
-the Euclidean shortest path length and ~1.08 times it (the 8-connected metric, 1/cos 22.5°).
+Speed: a Dijkstra over every cell of a house-sized map at 0.05 m is too slow for a tick
+(benchmarks/README.md, ``bench_map_core.py``), so the paths are searched on a **coarser grid** of
+``downsample`` × ``downsample`` fine cells per coarse cell (default: the factor giving cells closest
+to ``COARSE_RESOLUTION`` = 0.2 m, i.e. 4 at 0.05 m, 16 times fewer cells; ``downsample=1`` searches
+the fine grid itself). The coarsening is conservative: a coarse cell is blocked as soon as any of
+its fine cells is blocked, so walls never leak; openings narrower than about two coarse cells may
+close (the doors of a house are ~0.9 m wide), and paths keep up to a coarse cell from walls, so they
+come out a little longer than on the fine grid. Diagonal steps may not cut the corner of a blocked
+cell. The exact end points are joined to the coarse grid by straight segments to the centres of the
+3 × 3 coarse cells around them, each kept only when its line of sight is free on the fine grid — so
+a robot standing in a coarse cell that a nearby wall blocks still gets a path, and no shortcut
+crosses a wall. On the fine grid (``downsample=1``) a path length lies between the Euclidean
+shortest path length and ~1.08 times it (the 8-connected metric, 1/cos 22.5°).
 """
 
 from __future__ import annotations

@@ -37,6 +37,7 @@ from shapely.geometry import Polygon
 from pfctl.core.mapping.frontiers import (
     FrontierCluster,
     closest_point,
+    cluster_utilities,
     frontiers_from_states,
 )
 from pfctl.core.mapping.grid import FREE_THRESH, OCCUPIED, OCCUPIED_THRESH, UNKNOWN, GridGeometry
@@ -378,17 +379,14 @@ def waypoint_search(
         anchor = robot if target_point is None or nearest else np.asarray(target_point)
         starts = [robot] if target_point is None or nearest else [robot, anchor]
         fields = distance_fields(tr, np.array(starts))
-        # Eq. 3 for all clusters at once — the same numbers as utility(cluster, robot,
-        # target_point, alpha, fields[0], fields[1]), one vectorised field lookup per term.
+        # Eq. 3 for all clusters at once, one vectorised field lookup per term.
         goal_array = np.array([closest_point(c, anchor) for c in clusters])
-        cost = fields[0](goal_array)
-        if len(starts) == 2:
-            cost = cost + fields[1](goal_array)
+        from_robot = fields[0](goal_array)
         if nearest:
-            u = -cost
+            u = -from_robot
         else:
-            n_unknown = np.array([c.n_unknown for c in clusters], dtype=float)
-            u = alpha * n_unknown - cost
+            to_l_star = fields[1](goal_array) if len(starts) == 2 else None
+            u = cluster_utilities([c.n_unknown for c in clusters], from_robot, to_l_star, alpha)
         goals = [(float(g[0]), float(g[1])) for g in goal_array]
         utilities = [float(v) for v in u]
         if np.isfinite(u).any():

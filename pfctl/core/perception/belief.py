@@ -299,7 +299,7 @@ def _kth_largest(flat: NDArray[np.float64], k: int) -> float:
     """The ``k``-th largest value of ``flat`` (1 ≤ k ≤ size, counted with multiplicity).
 
     A belief grid holds many equal values (the prior, 0, p_min), on which ``numpy.partition``
-    is slow (~2.5 ms for 52 000 cells; this takes ~0.1 ms). For finite values ≥ 0 the IEEE
+    is slow (benchmarks/README.md). For finite values ≥ 0 the IEEE
     bits read as integers are ordered like the values, so 12 bits at a time, from the top, are
     ordered buckets: a bincount finds the bucket that holds the k-th value, and the search goes
     on inside it until its values are all equal (at most six rounds) or few.

@@ -1,10 +1,11 @@
 """dlib's face search for Algorithm 2 (§II-E) in a worker process, off the control loop.
 
 Algorithm 2 identifies the target by face first (:mod:`pfctl.core.perception.faces`: dlib's HOG
-detector, the 5-point alignment and the ResNet embedding). The embedding costs ~75–90 ms per face on
-one core and holds the GIL, and the HOG detector a few milliseconds per head, so run inline they
-blow a 10 Hz tick's budget whenever a face is found. :class:`FaceWorker` runs
-``FaceEncoder(params).detect(crop, region)`` in a persistent child process instead:
+detector, the 5-point alignment and the ResNet embedding). The embedding takes most of a 10 Hz
+tick's budget on one core and holds the GIL, and the HOG detector adds to it for every head, so
+run inline they blow the tick's budget whenever a face is found (benchmarks/bench_identity.py).
+:class:`FaceWorker` runs ``FaceEncoder(params).detect(crop, region)`` in a persistent child
+process instead:
 
 - the child is started with the ``spawn`` start method (the parent may hold PyBullet, which must
   not be forked), loads the three dlib models **once**, and serves jobs until it is closed;
@@ -15,8 +16,7 @@ blow a 10 Hz tick's budget whenever a face is found. :class:`FaceWorker` runs
   started only once the parent sleeps (Linux: its state in ``/proc``, looked at every
   millisecond, for at most :data:`PARENT_BUSY_WAIT_S`). SCHED_IDLE alone does not keep a freshly
   woken child off the CPU: at a scheduler tick it may be given a slice of the loop's tick
-  (measured on Linux 6.18, HZ 250, one core: ticks that submitted a crop took ~4 ms longer in
-  wall time than in CPU time; benchmarks/bench_follower.py);
+  (benchmarks/README.md, ``bench_follower.py``);
 - only the **head crop** crosses the process boundary (the region of the frame to search, a few
   KB), never the frame; the boxes come back in the frame's pixels, and the embeddings are the
   ones the inline encoder gives for the same region (same code, same models);

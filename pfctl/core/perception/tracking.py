@@ -309,7 +309,8 @@ def batch_predict(
 ) -> None:
     """``KalmanFilter.predict(F=F, Q=Q)`` of every filter at once (x ← F x, P ← F P Fᵀ + Q).
 
-    The same maths as filterpy's, batched with numpy: 10 filters in ~15 µs instead of ~35 µs.
+    The same maths as filterpy's, batched with numpy (one call for all tracks instead of one
+    per filter: less Python overhead per tick).
     Sets ``x``, ``P``, ``F``, ``Q`` and the ``x_prior`` / ``P_prior`` copies, as filterpy does.
     """
     if not filters:
@@ -330,7 +331,7 @@ def batch_update(
     ``K = P Hᵀ S⁻¹``, ``x ← x + K y``, and the Joseph form ``P ← (I − K H) P (I − K H)ᵀ + K R Kᵀ``.
     Sets ``x``, ``P``, ``y``, ``S``, ``SI``, ``K``, ``z``, the ``x_post`` / ``P_post`` copies and
     clears the cached likelihoods, as filterpy does (``R`` is per call, ``kf.R`` is left alone).
-    About 4 times faster than calling each filter's ``update`` (~15 µs each).
+    Batched for speed, as :func:`batch_predict`.
     """
     if not filters:
         return

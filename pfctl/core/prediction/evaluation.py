@@ -24,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pfctl.core.prediction.models import make_model
-from pfctl.core.prediction.tracks import Track
+from pfctl.core.prediction.trajectories import Trajectory
 
 __all__ = [
     "ModelSpec",
@@ -67,7 +67,9 @@ class Windows:
         )
 
 
-def make_windows(tracks: Sequence[Track], obs: int = 8, pred: int = 12, stride: int = 1) -> Windows:
+def make_windows(
+    tracks: Sequence[Trajectory], obs: int = 8, pred: int = 12, stride: int = 1
+) -> Windows:
     """Every run of ``obs + pred`` consecutive samples of every track, ``stride`` samples apart."""
     if obs < 1 or pred < 1 or stride < 1:
         raise ValueError(f"need obs ≥ 1, pred ≥ 1, stride ≥ 1; got {obs}, {pred}, {stride}")

@@ -35,9 +35,9 @@ four times more at 40 Hz.
 
 **Speed.** The SVRs are fitted by libsvm itself (:func:`fit_rbf_svr`), the solver
 ``sklearn.svm.SVR`` calls, with the same arguments: the same support vectors, coefficients and
-intercept, bit for bit, without scikit-learn's input validation around it, which costs ~1 ms
-per fit warm and ~5 ms the first time in a process (it looks for dataframe libraries) — more
-than the solver needs for a 3 s track (~0.1 ms). When that internal entry point is missing (another
+intercept, bit for bit, without scikit-learn's input validation around it, which costs more
+than the solver needs for a 3 s track, and most the first time in a process (it looks for
+dataframe libraries; benchmarks/README.md). When that internal entry point is missing (another
 scikit-learn), ``SVR`` is used.
 """
 
@@ -357,12 +357,12 @@ class SvrState(SvrTime):
     and a 0.5 s half-life come from :func:`pfctl.core.prediction.search.grid_search` with
     people split into train and test (``pfctl predict search``) on the ETH/UCY scenes, taking
     among the best grid points the one whose velocity does not collapse for fast walkers: the
-    grid's top point (C = 100, γ = 0.03; 2 % lower ADE) follows a 3 m/s run at only 77 % of its
-    speed, because its bounded dual coefficients cannot build a steep slope from a kernel that
-    wide. With these values a straight walk of 0.3–6 m/s is followed at 94–98 % of its speed
-    (the regulariser flattens the fit wherever the ε-tube lets it); the paper's γ = 1 gives 65–75 %,
-    the end slope of an interpolant bending back to its constant term, and is worse than
-    ``cv`` on real tracks. README "pfctl predict" has the numbers.
+    grid's top point (C = 100, γ = 0.03) lags a fast run, because its bounded dual coefficients
+    cannot build a steep slope from a kernel that wide. With these values a straight walk is
+    followed at nearly its speed (a little under: the regulariser flattens the fit wherever the
+    ε-tube lets it); the paper's γ = 1 follows it far slower, the end slope of an interpolant
+    bending back to its constant term, and is worse than ``cv`` on real tracks. README "pfctl
+    predict" and benchmarks/README.md have the numbers.
     """
 
     C: float = 1000.0

@@ -21,7 +21,7 @@ import numpy as np
 
 from pfctl.core.prediction.evaluation import ModelSpec, Score, Windows, evaluate, make_windows
 from pfctl.core.prediction.models import model_params
-from pfctl.core.prediction.tracks import Track
+from pfctl.core.prediction.trajectories import Trajectory
 
 __all__ = [
     "Candidate",
@@ -44,8 +44,8 @@ def param_grid(grid: Mapping[str, Sequence[Any]]) -> list[dict[str, Any]]:
 
 
 def split_by_person(
-    tracks: Sequence[Track], test_fraction: float = 0.5, seed: int = 0
-) -> tuple[list[Track], list[Track]]:
+    tracks: Sequence[Trajectory], test_fraction: float = 0.5, seed: int = 0
+) -> tuple[list[Trajectory], list[Trajectory]]:
     """Tracks split into (train, test) by person, ``test_fraction`` of the people in test."""
     if not 0.0 < test_fraction < 1.0:
         raise ValueError(f"test_fraction must be in (0, 1), got {test_fraction}")
@@ -115,7 +115,7 @@ def _score_all(
 def grid_search(
     model: str,
     grid: Mapping[str, Sequence[Any]],
-    scenes: Mapping[str, Sequence[Track]],
+    scenes: Mapping[str, Sequence[Trajectory]],
     obs: int = 8,
     pred: int = 12,
     test_fraction: float = 0.5,

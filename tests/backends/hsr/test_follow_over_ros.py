@@ -1,4 +1,4 @@
-"""The paper's episode over ROS 1 (issue 7): a private ``roscore``, ``pfctl sim serve-hsr
+"""The paper's episode over ROS 1: a private ``roscore``, ``pfctl sim serve-hsr
 missions/house.yaml`` as the robot, ``pfctl follow missions/house.yaml --backend hsr`` as the
 follower — two processes that only talk through the master — with ``rosbag record`` taping the
 robot's topics; then ``pfctl replay`` of that bag must give the live run's tracks.
@@ -206,10 +206,9 @@ def test_search_over_ros_finds_the_hidden_target(
 ) -> None:
     """``pfctl search --backend hsr`` against ``serve-hsr --hide living_room``: the robot
     starts in the kitchen without the target in view, searches (belief, Algorithm 1, frontiers)
-    and identifies her through the door. Seed 2: the simulator finds her after 20.2 s, over ROS
-    after 17.1 s (twice). Seed 1 is no test: she stands side-on to the laser there, her legs
-    show as one segment below the leg threshold, and Algorithm 2 waits for legs (found after
-    20.5 s in the simulator, not in 60 s over ROS)."""
+    and identifies her through the door. Seed 2, on which the simulator finds her too; seed 1 is
+    no test: she stands side-on to the laser there, her legs show as one segment below the leg
+    threshold, and Algorithm 2 waits for legs."""
     bridge_log = tmp_path / "serve.log"
     bridge = _spawn(
         [*PFCTL, "sim", "serve-hsr", str(HOUSE), "--seed", "2", "--hide", "living_room",

@@ -8,15 +8,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pfctl.app.leg_models import load_leg_model
 from pfctl.backends.pybullet.laser import FastLaser
 from pfctl.backends.pybullet.leg_scans import LASERS, LegScanGenerator, simulate_leg_scans
 from pfctl.backends.pybullet.walkers import LEG_RADIUS
-from pfctl.core.perception.legs.detector import (
-    LegDetector,
-    LegParams,
-    describe_segments,
-    load_leg_model,
-)
+from pfctl.core.perception.legs.detector import LegDetector, LegParams, describe_segments
 from pfctl.core.perception.legs.training import LegDataset, label_by_circles, scan_samples
 from pfctl.core.robot import Pose2D
 from pfctl.mission import load_mission

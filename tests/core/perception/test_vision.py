@@ -164,8 +164,8 @@ def test_make_detector_auto_picks_mask_with_a_mask_else_hog() -> None:
 
 
 def _reference_detect(det: MaskPersonDetector, frame: RgbdFrame) -> list[tuple]:
-    """The mask detector written plainly, one full-image pass per person (as it was before the
-    lookup tables and the one sort): its detections as comparable tuples."""
+    """The mask detector written plainly, one full-image pass per person (no lookup tables, no
+    sort): its detections as comparable tuples."""
     from pfctl.core.perception.vision import _PARTS, _bbox
 
     assert frame.mask is not None

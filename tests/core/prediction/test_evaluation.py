@@ -7,16 +7,16 @@ import pytest
 
 from pfctl.core.prediction.evaluation import ModelSpec, evaluate, evaluate_per_window, make_windows
 from pfctl.core.prediction.search import grid_search, param_grid, split_by_person
-from pfctl.core.prediction.tracks import Track
+from pfctl.core.prediction.trajectories import Trajectory
 
 
-def _straight(n: int, v: tuple[float, float], name: str, dt: float = 0.4) -> Track:
+def _straight(n: int, v: tuple[float, float], name: str, dt: float = 0.4) -> Trajectory:
     t = np.arange(n) * dt
     xy = np.stack([v[0] * t, v[1] * t], axis=1)
-    return Track(t, xy, name=name, source="synthetic", person=name)
+    return Trajectory(t, xy, name=name, source="synthetic", person=name)
 
 
-def _walkers(count: int, seed: int, n: int = 24, noise: float = 0.01) -> list[Track]:
+def _walkers(count: int, seed: int, n: int = 24, noise: float = 0.01) -> list[Trajectory]:
     """Walkers at 0.8–1.4 m/s with a slow constant turn and ``noise`` m of noise, 0.4 s steps."""
     rng = np.random.default_rng(seed)
     tracks = []
@@ -26,7 +26,7 @@ def _walkers(count: int, seed: int, n: int = 24, noise: float = 0.01) -> list[Tr
         heading = rng.uniform(-np.pi, np.pi) + rng.uniform(-0.15, 0.15) * t
         step = np.stack([np.cos(heading), np.sin(heading)], axis=1) * speed * 0.4
         xy = np.cumsum(step, axis=0) + rng.normal(0.0, noise, (n, 2))
-        tracks.append(Track(t, xy, name=f"w{i}", source="synthetic", person=f"w{i}"))
+        tracks.append(Trajectory(t, xy, name=f"w{i}", source="synthetic", person=f"w{i}"))
     return tracks
 
 
@@ -45,7 +45,7 @@ def test_cv_is_exact_on_straight_tracks_and_others_close() -> None:
     w = make_windows([_straight(30, (1.2, -0.3), "a")], 8, 12)
     scores = evaluate([ModelSpec.of(n) for n in ("cv", "poly3", "svr")], w)
     assert scores["cv"].ade < 1e-9 and scores["poly3"].ade < 1e-6
-    assert scores["svr"].ade < 0.3  # the regularised end slope: ~5 % slower (see prediction.py)
+    assert scores["svr"].ade < 0.3  # the regularised end slope lags (core/prediction/models.py)
     for s in scores.values():
         assert s.n == len(w) and s.ms_per_call > 0
         assert s.fde >= s.ade - 1e-12  # straight: error grows with the horizon
@@ -56,7 +56,7 @@ def test_ade_fde_definitions() -> None:
     # cv with a stopped person: the error at k steps ahead is 0.4·k m
     ade, fde, _ = evaluate_per_window([ModelSpec.of("cv", window_s=0.8)], w)["cv"]
     assert ade[0] == pytest.approx(0.0, abs=1e-9) and fde[0] == pytest.approx(0.0, abs=1e-9)
-    stopped = Track(
+    stopped = Trajectory(
         np.arange(20) * 0.4,
         np.vstack([np.zeros((8, 2)), np.stack([np.arange(1, 13) * 0.4, np.zeros(12)], axis=1)]),
         name="s",
@@ -89,7 +89,7 @@ def test_param_grid_and_person_split() -> None:
     with pytest.raises(ValueError):
         param_grid({"a": []})
     pieces = [
-        Track(np.arange(3.0), np.zeros((3, 2)), name=f"p{i}.{k}", person=f"p{i}")
+        Trajectory(np.arange(3.0), np.zeros((3, 2)), name=f"p{i}.{k}", person=f"p{i}")
         for i in range(10)
         for k in range(2)
     ]

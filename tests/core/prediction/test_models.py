@@ -31,10 +31,9 @@ def _arc(t: np.ndarray, r: float = 3.0, speed: float = 1.0) -> np.ndarray:
 
 
 # Tolerances (m) at 1 s and 2 s past the last sample, for a straight walk at 1.08 m/s.
-# cv and poly3 are exact; svr follows a line at ~95 % of its speed (measured 5 cm off at 1 s, 10 cm
-# at 2 s: its regularised end slope, a shrinkage that helps it on real tracks);
-# svr-time bends back to its mean beyond ~1 s, so it is held to 0.1/0.2 s (13 cm off at 0.2 s,
-# measured — the flaw svr fixes).
+# cv and poly3 are exact; svr follows a line a little slower than it walks (its regularised end
+# slope, a shrinkage that helps it on real tracks); svr-time bends back to its mean beyond ~1 s,
+# so it is held to 0.1/0.2 s (the flaw svr fixes).
 LINE_CASES = {
     "cv": ((1.0, 2.0), 1e-6),
     "poly3": ((1.0, 2.0), 1e-6),
@@ -53,8 +52,8 @@ def test_straight_line_is_recovered(name: str) -> None:
 
 
 # Constant-speed arc, 1 m/s on a 3 m radius, 1 s ahead. cv cannot turn: 0.5·v²/r·t² = 0.17 m
-# plus the lag of a 0.8 s mean velocity (measured 0.30 m); svr likewise (0.29 m);
-# poly3 fits the arc's Taylor expansion up to t³ (3 cm off, measured); svr-time 0.2 s ahead.
+# plus the lag of a 0.8 s mean velocity; svr likewise; poly3 fits the arc's Taylor expansion up
+# to t³; svr-time 0.2 s ahead.
 ARC_CASES = {
     "cv": (1.0, 0.35),
     "svr": (1.0, 0.35),
@@ -119,8 +118,7 @@ def test_recency_weights_follow_a_late_turn_better_svr_time() -> None:
 
 
 def test_recency_weights_follow_a_late_turn_better_poly3() -> None:
-    """The cubic's prediction 0.5 and 1 s after the turn is closer with weights (measured: 1.3 m
-    → 0.7 m mean error)."""
+    """The cubic's prediction 0.5 and 1 s after the turn is closer with weights."""
     t, xy, tf, truth = _late_turn()
     err = {}
     for kind in ("none", "exponential"):

@@ -22,16 +22,17 @@ Clothes are measured on every observation until the track's clothes evidence is 
 ``clothes_settled`` samples and either a face deciding the track (then clothes no longer enter
 Algorithm 2's decision at all) or a mean similarity at least ``clothes_margin`` away from the
 ``clothes_similarity`` threshold. A settled track's clothes are measured again only every
-``clothes_recheck_s`` (a histogram pair costs ~0.5–1 ms per person at 320x240, six people ~5 ms
-a frame; benchmarks/bench_identity.py). The decision is the mean S over the samples; a settled
+``clothes_recheck_s`` (a histogram pair per person and frame adds up in a crowd;
+benchmarks/bench_identity.py measures it). The decision is the mean S over the samples; a settled
 track has fewer of them, each weighing more, so new evidence moves its mean about as fast in
-time as before, and a track whose mean comes back within the margin of the threshold is measured
-on every frame again. Which tracks Algorithm 2 names is unchanged on the tests' episodes.
+time as on every frame, and a track whose mean comes back within the margin of the threshold is
+measured on every frame again.
 
-The face search itself (dlib's HOG detector and ResNet embedding, ~75–90 ms per face) runs inline
-by default, or — given a :class:`~pfctl.core.perception.face_worker.FaceWorker` — in a worker
-process: the head crop is submitted and the result folded into the track's evidence when it comes
-back (a track deleted meanwhile is skipped). How results are folded in is ``face_timing``:
+The face search itself (dlib's HOG detector and ResNet embedding, far more than a tick's budget
+per face; benchmarks/bench_identity.py) runs inline by default, or — given a
+:class:`~pfctl.core.perception.face_worker.FaceWorker` — in a worker process: the head crop is
+submitted and the result folded into the track's evidence when it comes back (a track deleted
+meanwhile is skipped). How results are folded in is ``face_timing``:
 
 - ``deterministic`` (the simulator): a search submitted with the frame stamped t is folded in at
   the first observation stamped t + ``face_latency_s`` or later, waiting for the worker then if

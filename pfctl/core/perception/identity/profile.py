@@ -1,23 +1,21 @@
 """The target's appearance for Algorithm 2 (§II-E): what one frame shows of a person (clothes
 histograms, a face), and the target's profile learned from such frames.
 
-:class:`TargetProfile` is what ``pfctl learn-target`` writes: the target's upper and lower
-clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, saved as a versioned
-``.npz`` (no pickles).
+:class:`TargetProfile` is what ``pfctl learn-target`` learns: the target's upper and lower
+clothing histograms and up to :data:`MAX_PROFILE_FACES` face embeddings, as the bytes of a
+versioned ``.npz`` (no pickles). Reading and writing the files is the app's
+(:mod:`pfctl.app.profiles`).
 """
 
 from __future__ import annotations
 
 import io
 import math
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
-from pfctl.core.atomic_files import atomic_write
 from pfctl.core.perception.clothes import (
     ClothesParams,
     ColorSpace,
@@ -34,7 +32,6 @@ from pfctl.core.perception.faces import (
 )
 from pfctl.core.perception.identity.params import IdentityParams
 from pfctl.core.perception.vision import PersonDetection
-from pfctl.errors import UserError
 
 #: Version of the profile file format.
 PROFILE_VERSION = 1
@@ -153,7 +150,7 @@ class TargetProfile:
         ]
         return min(s) if s else None
 
-    # .npz I/O ------------------------------------------------------------------------------------
+    # .npz bytes ----------------------------------------------------------------------------------
 
     def to_bytes(self) -> bytes:
         """The profile as ``.npz`` bytes (version, histograms, faces, colour space, bins)."""
@@ -170,45 +167,35 @@ class TargetProfile:
         )
         return buf.getvalue()
 
-    def save(self, path: str | os.PathLike[str]) -> Path:
-        """Write the profile to ``path`` atomically."""
-        return atomic_write(path, self.to_bytes())
-
     @classmethod
-    def load(cls, path: str | os.PathLike[str]) -> TargetProfile:
-        """Read a profile written by :meth:`save`; a bad file is a one-line UserError."""
-        name = str(path)
+    def from_bytes(cls, data: bytes) -> TargetProfile:
+        """The profile in :meth:`to_bytes`'s bytes, checked; ValueError (one line: what is wrong
+        and which field) if they are not a usable profile."""
         try:
-            with np.load(path, allow_pickle=False) as data:
-                fields = {k: data[k] for k in data.files}
-        except FileNotFoundError:
-            raise UserError(f"{name}: no such target profile") from None
+            with np.load(io.BytesIO(data), allow_pickle=False) as npz:
+                fields = {k: npz[k] for k in npz.files}
         except (OSError, ValueError) as err:
-            raise UserError(f"{name}: not a target profile (.npz): {err}") from None
+            raise ValueError(f"not a target profile (.npz): {err}") from None
         missing = {"version", "upper", "lower", "faces", "color_space", "bins"} - set(fields)
         if missing:
-            raise UserError(f"{name}: not a target profile: missing {', '.join(sorted(missing))}")
+            raise ValueError(f"not a target profile: missing {', '.join(sorted(missing))}")
         version = int(fields["version"])
         if version != PROFILE_VERSION:
-            raise UserError(
-                f"{name}: version: expected {PROFILE_VERSION}, got {version} (learn it again)"
-            )
+            raise ValueError(f"version: expected {PROFILE_VERSION}, got {version} (learn it again)")
         space = str(fields["color_space"])
         if space not in ("hsv", "rgb", "lab"):
-            raise UserError(f"{name}: color_space: expected hsv, rgb or lab, got {space!r}")
+            raise ValueError(f"color_space: expected hsv, rgb or lab, got {space!r}")
         bins = tuple(int(b) for b in np.ravel(fields["bins"]))
         if len(bins) != 3 or min(bins) < 1:
-            raise UserError(f"{name}: bins: expected three positive counts, got {bins}")
+            raise ValueError(f"bins: expected three positive counts, got {bins}")
         size = int(np.prod(bins))
         upper, lower = (np.asarray(fields[k], dtype=np.float64).ravel() for k in ("upper", "lower"))
         for key, h in (("upper", upper), ("lower", lower)):
             if h.size != size or not np.all(np.isfinite(h)) or np.any(h < 0):
-                raise UserError(
-                    f"{name}: {key}: expected {size} finite non-negative histogram bins"
-                )
+                raise ValueError(f"{key}: expected {size} finite non-negative histogram bins")
         faces = np.asarray(fields["faces"], dtype=np.float64)
         if faces.ndim != 2 or faces.shape[1] != EMBEDDING_SIZE or not np.all(np.isfinite(faces)):
-            raise UserError(f"{name}: faces: expected a (k, {EMBEDDING_SIZE}) array")
+            raise ValueError(f"faces: expected a (k, {EMBEDDING_SIZE}) array")
         return cls(
             upper=upper,
             lower=lower,
@@ -219,10 +206,11 @@ class TargetProfile:
         )
 
     def check_params(self, params: IdentityParams, source: str = "profile") -> None:
-        """A UserError unless the profile's histograms are in the mission's colour space/bins."""
+        """ValueError (one line, starting with ``source``) unless the profile's histograms are in
+        the colour space and bins of ``params`` (the mission's)."""
         want = params.clothes
         if (self.color_space, tuple(self.bins)) != (want.color_space, tuple(want.bins)):
-            raise UserError(
+            raise ValueError(
                 f"{source}: histograms are {self.color_space} {list(self.bins)}, the mission's "
                 f"perception.identity wants {want.color_space} {list(want.bins)} (learn it again)"
             )

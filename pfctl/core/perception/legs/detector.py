@@ -27,8 +27,6 @@ the leg, its axis is behind.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
@@ -39,7 +37,7 @@ from pfctl.core.perception.legs.features import (
     segment_features,
     segment_scan,
 )
-from pfctl.core.perception.legs.model import LegModel, read_leg_model
+from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.robot import LaserScan
 
 #: From a leg's visible surface to its axis along the beam, metres (≈ 0.75 × a 6 cm leg radius:
@@ -111,16 +109,6 @@ class ClassifiedSegments:
     features: np.ndarray
     classified: np.ndarray
     probability: np.ndarray
-
-
-def shipped_model_path() -> Path:
-    """The model shipped with pfctl (``pfctl/data/legs_model.npz``)."""
-    return Path(str(resources.files("pfctl") / "data" / "legs_model.npz"))
-
-
-def load_leg_model(path: Path | None = None) -> LegModel:
-    """Load a leg model (``None``: the shipped one); one-line :class:`UserError` if unusable."""
-    return read_leg_model(shipped_model_path() if path is None else Path(path), FEATURE_NAMES)
 
 
 def describe_segments(
@@ -233,7 +221,5 @@ __all__ = [
     "PersonCandidate",
     "classify_segments",
     "describe_segments",
-    "load_leg_model",
     "pair_legs",
-    "shipped_model_path",
 ]

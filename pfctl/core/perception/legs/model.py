@@ -1,4 +1,4 @@
-"""The leg classifier's file format: a random forest as plain arrays in an ``.npz`` (no pickle).
+"""The leg classifier: a random forest as plain arrays, stored as an ``.npz`` (no pickle).
 
 The paper classifies laser segments with a random forest (§II-E). It is trained with
 scikit-learn's ``RandomForestClassifier`` (``pfctl legs train``) and shipped as numbers only, so
@@ -22,6 +22,10 @@ File format (``.npz``, version :data:`FORMAT_VERSION`)::
 As in scikit-learn, features are rounded to float32 before they are compared. scikit-learn's
 float64 thresholds are stored as the largest float32 not above them, which splits every float32
 feature value exactly as the float64 threshold does (and halves the file).
+
+This module turns a model into those bytes and back (:meth:`LegModel.to_bytes`,
+:meth:`LegModel.from_bytes`); reading and writing the files, and the model shipped with pfctl,
+are the app's (:mod:`pfctl.app.leg_models`).
 """
 
 from __future__ import annotations
@@ -30,21 +34,12 @@ import json
 import zipfile
 from dataclasses import dataclass
 from io import BytesIO
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from pfctl.core.atomic_files import atomic_write
-from pfctl.errors import UserError
-
 FORMAT = "pfctl-leg-forest"
 FORMAT_VERSION = 1
-
-
-class LegModelError(UserError):
-    """A leg model file that cannot be used (missing, corrupt, foreign, other features)."""
-
 
 _ARRAYS = ("roots", "left", "right", "feature", "threshold", "leaf_probability")
 
@@ -146,9 +141,54 @@ class LegModel:
         )
         return buf.getvalue()
 
-    def save(self, path: Path) -> Path:
-        """Write the model to ``path`` atomically (nothing partial on error)."""
-        return atomic_write(path, self.to_bytes())
+    @classmethod
+    def from_bytes(cls, data: bytes, expected_features: tuple[str, ...] | None = None) -> LegModel:
+        """The model in :meth:`to_bytes`'s bytes.
+
+        ValueError (one line) for bytes that are not a leg model (corrupt, foreign, pickled), a
+        newer format, damaged or inconsistent tree arrays, or (with ``expected_features``) a
+        model trained on other features.
+        """
+        try:
+            with np.load(BytesIO(data), allow_pickle=False) as npz:
+                arrays = {name: npz[name] for name in npz.files}
+        except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
+            raise ValueError(f"not a leg model (.npz without pickles): {err}") from None
+        if str(arrays.get("format", "")) != FORMAT:
+            raise ValueError(f"not a leg model: the file has no format '{FORMAT}'")
+        try:
+            version = int(arrays["version"])
+        except (KeyError, ValueError, TypeError) as err:
+            raise ValueError(f"damaged leg model: {err}") from None
+        if version > FORMAT_VERSION:
+            raise ValueError(
+                f"leg model format {version} is newer than this pfctl reads "
+                f"({FORMAT_VERSION}); upgrade pfctl or retrain with `pfctl legs train`"
+            )
+        try:
+            names = tuple(str(s) for s in arrays["feature_names"])
+            metadata = json.loads(str(arrays["metadata"]))
+            model = cls(
+                feature_names=names,
+                roots=np.asarray(arrays["roots"], dtype=np.int32),
+                left=np.asarray(arrays["left"], dtype=np.int32),
+                right=np.asarray(arrays["right"], dtype=np.int32),
+                feature=np.asarray(arrays["feature"], dtype=np.int32),
+                threshold=np.asarray(arrays["threshold"], dtype=np.float32),
+                leaf_probability=np.asarray(arrays["leaf_probability"], dtype=np.float32),
+                depth=int(arrays["depth"]),
+                metadata=metadata if isinstance(metadata, dict) else {},
+            )
+        except (KeyError, ValueError, TypeError) as err:
+            raise ValueError(f"damaged leg model: {err}") from None
+        _check(model)
+        if expected_features is not None and model.feature_names != tuple(expected_features):
+            raise ValueError(
+                f"the leg model was trained on features {', '.join(model.feature_names)}; "
+                f"this pfctl computes {', '.join(expected_features)} "
+                "(retrain with `pfctl legs train`)"
+            )
+        return model
 
 
 def _float32_floor(values: np.ndarray) -> np.ndarray:
@@ -160,57 +200,7 @@ def _float32_floor(values: np.ndarray) -> np.ndarray:
     return out
 
 
-def read_leg_model(path: Path, expected_features: tuple[str, ...] | None = None) -> LegModel:
-    """Load a model written by :meth:`LegModel.save`.
-
-    Raises :class:`LegModelError` (a :class:`UserError`: one line naming the file) for a
-    missing, corrupt or foreign file, a newer format, or (with ``expected_features``) a model
-    trained on other features.
-    """
-    path = Path(path)
-    if not path.is_file():
-        raise LegModelError(f"{path}: no such leg model file (write one with `pfctl legs train`)")
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {name: data[name] for name in data.files}
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as err:
-        raise LegModelError(f"{path}: not a leg model (.npz without pickles): {err}") from None
-    if str(arrays.get("format", "")) != FORMAT:
-        raise LegModelError(f"{path}: not a leg model: the file has no format '{FORMAT}'")
-    try:
-        version = int(arrays["version"])
-        if version > FORMAT_VERSION:
-            raise LegModelError(
-                f"{path}: leg model format {version} is newer than this pfctl reads "
-                f"({FORMAT_VERSION}); upgrade pfctl or retrain with `pfctl legs train`"
-            )
-        names = tuple(str(s) for s in arrays["feature_names"])
-        metadata = json.loads(str(arrays["metadata"]))
-        model = LegModel(
-            feature_names=names,
-            roots=np.asarray(arrays["roots"], dtype=np.int32),
-            left=np.asarray(arrays["left"], dtype=np.int32),
-            right=np.asarray(arrays["right"], dtype=np.int32),
-            feature=np.asarray(arrays["feature"], dtype=np.int32),
-            threshold=np.asarray(arrays["threshold"], dtype=np.float32),
-            leaf_probability=np.asarray(arrays["leaf_probability"], dtype=np.float32),
-            depth=int(arrays["depth"]),
-            metadata=metadata if isinstance(metadata, dict) else {},
-        )
-    except LegModelError:
-        raise
-    except (KeyError, ValueError, TypeError) as err:
-        raise LegModelError(f"{path}: damaged leg model: {err}") from None
-    _check(path, model)
-    if expected_features is not None and model.feature_names != tuple(expected_features):
-        raise LegModelError(
-            f"{path}: the leg model was trained on features {', '.join(model.feature_names)}; "
-            f"this pfctl computes {', '.join(expected_features)} (retrain with `pfctl legs train`)"
-        )
-    return model
-
-
-def _check(path: Path, model: LegModel) -> None:
+def _check(model: LegModel) -> None:
     """Refuse node arrays that would index out of bounds or do not line up."""
     m = model.n_nodes
     sizes = {len(getattr(model, a)) for a in _ARRAYS[1:]}
@@ -225,7 +215,7 @@ def _check(path: Path, model: LegModel) -> None:
         and np.all((model.feature >= 0) & (model.feature < max(len(model.feature_names), 1)))
     )
     if not ok:
-        raise LegModelError(f"{path}: damaged leg model: inconsistent tree arrays")
+        raise ValueError("damaged leg model: inconsistent tree arrays")
 
 
-__all__ = ["FORMAT", "FORMAT_VERSION", "LegModel", "LegModelError", "read_leg_model"]
+__all__ = ["FORMAT", "FORMAT_VERSION", "LegModel"]

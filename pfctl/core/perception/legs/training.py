@@ -23,7 +23,6 @@ from typing import Any
 
 import numpy as np
 
-from pfctl import __version__
 from pfctl.core.perception.legs.detector import LegParams, describe_segments
 from pfctl.core.perception.legs.evidence import LegEvidence
 from pfctl.core.perception.legs.features import FEATURE_NAMES, Segments
@@ -204,7 +203,8 @@ def train_forest(
     metadata: dict[str, Any] | None = None,
 ) -> LegModel:
     """Fit a seeded ``RandomForestClassifier`` on ``data`` and return it as a :class:`LegModel`
-    (metadata: sizes, seed, date, pfctl version, forest parameters, plus ``metadata``)."""
+    (metadata: sizes, seed, date, forest parameters, plus the caller's ``metadata``, e.g. the
+    data sets and the pfctl version)."""
     from sklearn.ensemble import RandomForestClassifier
 
     if len(data) == 0 or data.positives == 0 or data.positives == len(data):
@@ -221,7 +221,6 @@ def train_forest(
     meta = {
         "seed": seed,
         "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
-        "pfctl_version": __version__,
         "forest": {
             "n_estimators": n_trees,
             "max_depth": max_depth,

@@ -29,8 +29,9 @@ from pathlib import Path
 import numpy as np
 
 import pfctl
+from pfctl.app.leg_models import load_leg_model
 from pfctl.backends.hsr.robot import HsrRobot
-from pfctl.core.perception.legs.detector import LegDetector, load_leg_model
+from pfctl.core.perception.legs.detector import LegDetector
 from pfctl.core.perception.tracking import FieldOfView
 from pfctl.core.robot import STOP, HeadTarget, Pose2D, RobotLostError, Twist2D
 from pfctl.errors import UserError

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
+import io
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 from sklearn.ensemble import RandomForestClassifier
 
-from pfctl.core.perception.legs.detector import LegParams, load_leg_model, pair_legs
+from pfctl.core.perception.legs.detector import LegParams, pair_legs
 from pfctl.core.perception.legs.features import (
     FEATURE_NAMES,
     MAX_JUMP,
@@ -17,9 +17,8 @@ from pfctl.core.perception.legs.features import (
     segment_features,
     segment_scan,
 )
-from pfctl.core.perception.legs.model import LegModel, LegModelError, read_leg_model
+from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.perception.legs.training import LegDataset, label_by_positions, score, train_forest
-from pfctl.errors import UserError
 
 F = {name: i for i, name in enumerate(FEATURE_NAMES)}
 
@@ -115,50 +114,26 @@ def _forest(seed: int = 0) -> tuple[RandomForestClassifier, np.ndarray]:
     return forest, rng.normal(size=(300, len(FEATURE_NAMES)))
 
 
-def test_npz_model_round_trips_and_matches_sklearn(tmp_path: Path) -> None:
+def test_npz_model_round_trips_and_matches_sklearn() -> None:
     forest, x = _forest()
     model = LegModel.from_forest(forest, FEATURE_NAMES, {"seed": 0})
-    path = model.save(tmp_path / "m.npz")
-    loaded = read_leg_model(path, FEATURE_NAMES)
+    data = model.to_bytes()
+    loaded = LegModel.from_bytes(data, FEATURE_NAMES)
     assert loaded.metadata == {"seed": 0}
     assert loaded.n_trees == 7
     np.testing.assert_allclose(loaded.predict_proba(x), forest.predict_proba(x)[:, 1], atol=1e-6)
-    with np.load(path, allow_pickle=False) as data:  # plain arrays only
-        assert int(data["version"]) == 1
+    with np.load(io.BytesIO(data), allow_pickle=False) as arrays:  # plain arrays only
+        assert int(arrays["version"]) == 1
 
 
-def test_foreign_or_corrupt_model_files_are_user_errors(tmp_path: Path) -> None:
-    bad = tmp_path / "bad.npz"
-    bad.write_bytes(b"not a zip at all")
-    with pytest.raises(UserError, match=r"bad.npz: not a leg model"):
-        read_leg_model(bad)
-    other = tmp_path / "other.npz"
-    np.savez(other, weights=np.zeros(3))
-    with pytest.raises(LegModelError, match=r"other.npz: not a leg model"):
-        read_leg_model(other)
-    with pytest.raises(UserError, match="no such leg model"):
-        read_leg_model(tmp_path / "missing.npz")
+def test_bytes_that_are_no_leg_model_for_these_features_are_value_errors() -> None:
     forest, _ = _forest()
+    with pytest.raises(ValueError, match=r"^not a leg model"):
+        LegModel.from_bytes(b"not a zip at all")
     names = tuple(f"f{i}" for i in range(len(FEATURE_NAMES)))
-    LegModel.from_forest(forest, names, {}).save(tmp_path / "f.npz")
-    with pytest.raises(UserError, match="trained on features f0, f1"):
-        read_leg_model(tmp_path / "f.npz", FEATURE_NAMES)
-    with pytest.raises(UserError, match=r"f.npz"):
-        load_leg_model(tmp_path / "f.npz")
-    for err in (LegModelError("x"),):
-        assert "\n" not in str(err)
-
-
-def test_model_with_broken_arrays_is_refused(tmp_path: Path) -> None:
-    forest, _ = _forest()
-    model = LegModel.from_forest(forest, FEATURE_NAMES, {})
-    path = model.save(tmp_path / "m.npz")
-    with np.load(path, allow_pickle=False) as data:
-        arrays = dict(data)
-    arrays["left"] = arrays["left"] + 10_000
-    np.savez(tmp_path / "broken.npz", **arrays)
-    with pytest.raises(UserError, match=r"broken.npz: damaged leg model"):
-        read_leg_model(tmp_path / "broken.npz")
+    other = LegModel.from_forest(forest, names, {}).to_bytes()
+    with pytest.raises(ValueError, match=r"^the leg model was trained on features f0, f1"):
+        LegModel.from_bytes(other, FEATURE_NAMES)
 
 
 def test_pairing_matches_closest_legs_and_keeps_confident_singles() -> None:

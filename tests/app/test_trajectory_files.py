@@ -7,14 +7,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pfctl.core.prediction.tracks import (
-    TrajectoryFileError,
-    frame_step_of,
-    read_csv_track,
-    read_frames,
-    read_tracks,
-    track_to_csv,
-)
+from pfctl.app.trajectory_files import read_csv_trajectory, read_frames, read_trajectories
+from pfctl.core.prediction.trajectories import trajectory_to_csv
+from pfctl.errors import UserError
 
 
 def _write(tmp_path: Path, name: str, text: str) -> Path:
@@ -25,7 +20,7 @@ def _write(tmp_path: Path, name: str, text: str) -> Path:
 
 def test_csv_any_column_order_and_extra_columns(tmp_path: Path) -> None:
     path = _write(tmp_path, "a.csv", "id,y,t,x\n7,0.5,0.0,1.0\n7,0.6,0.1,1.1\n\n7,0.7,0.2,1.2\n")
-    tr = read_csv_track(path)
+    tr = read_csv_trajectory(path)
     np.testing.assert_allclose(tr.t, [0.0, 0.1, 0.2])
     np.testing.assert_allclose(tr.xy, [[1.0, 0.5], [1.1, 0.6], [1.2, 0.7]])
     assert tr.name == str(path) and tr.person == str(path)
@@ -34,8 +29,8 @@ def test_csv_any_column_order_and_extra_columns(tmp_path: Path) -> None:
 def test_csv_round_trip(tmp_path: Path) -> None:
     t = np.array([0.0, 0.5, 1.0])
     xy = np.array([[0.0, 1.0], [0.25, 1.5], [0.5, 2.0]])
-    path = _write(tmp_path, "r.csv", track_to_csv(t, xy))
-    tr = read_csv_track(path)
+    path = _write(tmp_path, "r.csv", trajectory_to_csv(t, xy))
+    tr = read_csv_trajectory(path)
     np.testing.assert_allclose(tr.t, t)
     np.testing.assert_allclose(tr.xy, xy)
 
@@ -58,8 +53,8 @@ def test_csv_errors_name_file_line_and_field(
     tmp_path: Path, text: str, fragments: list[str]
 ) -> None:
     path = _write(tmp_path, "bad.csv", text)
-    with pytest.raises(TrajectoryFileError) as info:
-        read_csv_track(path)
+    with pytest.raises(UserError) as info:
+        read_csv_trajectory(path)
     message = str(info.value)
     assert message.startswith(str(path))
     assert "\n" not in message
@@ -68,14 +63,14 @@ def test_csv_errors_name_file_line_and_field(
 
 
 def test_missing_file_and_folder(tmp_path: Path) -> None:
-    with pytest.raises(TrajectoryFileError, match="no such file"):
-        read_csv_track(tmp_path / "nope.csv")
-    with pytest.raises(TrajectoryFileError, match="is a directory"):
-        read_csv_track(tmp_path)
-    with pytest.raises(TrajectoryFileError, match=r"no \*\.txt files"):
-        read_tracks(tmp_path, "frames", fps=2.5)
-    with pytest.raises(TrajectoryFileError, match="needs a frame rate"):
-        read_tracks(tmp_path, "frames")
+    with pytest.raises(UserError, match="no such file"):
+        read_csv_trajectory(tmp_path / "nope.csv")
+    with pytest.raises(UserError, match="is a directory"):
+        read_csv_trajectory(tmp_path)
+    with pytest.raises(UserError, match=r"no \*\.txt files"):
+        read_trajectories(tmp_path, "frames", fps=2.5)
+    with pytest.raises(UserError, match="needs a frame rate"):
+        read_trajectories(tmp_path, "frames")
 
 
 FRAMES = """\
@@ -103,16 +98,10 @@ def test_frames_fps_is_annotated_steps_per_second(tmp_path: Path) -> None:
     np.testing.assert_allclose(by_name["2.1"].t, [2.0, 2.4])
     assert by_name["2.0"].person == by_name["2.1"].person == f"{path}#2"
     # an explicit frame step of 5 makes frame ids step by 2 → no track with 2 consecutive steps
-    with pytest.raises(TrajectoryFileError, match="no track has 2 consecutive steps"):
+    with pytest.raises(UserError, match="no track has 2 consecutive steps"):
         read_frames(path, fps=5.0, frame_step=5.0)
     # 1 step per second: times in steps
     np.testing.assert_allclose(read_frames(path, fps=1.0)[0].t, [0.0, 1.0, 2.0])
-
-
-def test_frame_step_is_the_gcd() -> None:
-    assert frame_step_of([780, 790, 800, 840]) == 10.0
-    assert frame_step_of([0, 6, 12]) == 6.0
-    assert frame_step_of([3]) == 1.0
 
 
 @pytest.mark.parametrize(
@@ -128,7 +117,7 @@ def test_frame_step_is_the_gcd() -> None:
 def test_frames_errors(tmp_path: Path, text: str, fragments: list[str]) -> None:
     path = _write(tmp_path, "bad.txt", text)
     step = 10.0 if "15" in text else None
-    with pytest.raises(TrajectoryFileError) as info:
+    with pytest.raises(UserError) as info:
         read_frames(path, fps=2.5, frame_step=step)
     message = str(info.value)
     assert message.startswith(str(path)) and "\n" not in message
@@ -138,25 +127,25 @@ def test_frames_errors(tmp_path: Path, text: str, fragments: list[str]) -> None:
 
 def test_frames_bad_fps(tmp_path: Path) -> None:
     path = _write(tmp_path, "f.txt", FRAMES)
-    with pytest.raises(TrajectoryFileError, match="fps must be a positive number"):
+    with pytest.raises(UserError, match="fps must be a positive number"):
         read_frames(path, fps=0.0)
 
 
-def test_read_tracks_folder_is_recursive(tmp_path: Path) -> None:
+def test_read_trajectories_folder_is_recursive(tmp_path: Path) -> None:
     (tmp_path / "a").mkdir()
     _write(tmp_path / "a", "one.txt", FRAMES)
     _write(tmp_path, "two.txt", FRAMES)
     _write(tmp_path, "ignored.csv", "t,x,y\n0,0,0\n1,1,1\n")
-    tracks = read_tracks(tmp_path, "frames", fps=2.5)
+    tracks = read_trajectories(tmp_path, "frames", fps=2.5)
     assert len(tracks) == 6
     assert {Path(t.source).name for t in tracks} == {"one.txt", "two.txt"}
-    csv_tracks = read_tracks(tmp_path, "csv")
+    csv_tracks = read_trajectories(tmp_path, "csv")
     assert len(csv_tracks) == 1
 
 
 def test_track_last_seconds(tmp_path: Path) -> None:
     path = _write(tmp_path, "a.csv", "t,x,y\n" + "".join(f"{i / 10},{i},0\n" for i in range(40)))
-    tr = read_csv_track(path)
+    tr = read_csv_trajectory(path)
     assert len(tr.last(1.0)) == 11  # 2.9 s back to 3.9 s, both ends included
     assert len(tr.last(0.0)) == 2
     assert tr.duration == pytest.approx(3.9)
