@@ -11,6 +11,7 @@ fields are SI values, and :meth:`Mission.layout` turns the ``map`` section into 
 :mod:`.backend`        the ``backend`` section (the HSR's topics and frames)
 :mod:`.tree`           behavior-tree node models (``behavior.tree``), the paper's tree
 :mod:`.types`          value types of fields (finite numbers, polygons, limits), the base model
+:mod:`.params`         keys the core declares (``FromCore``), and core parameters built from them
 :mod:`.loading`        :func:`load_mission`: ``extends``, ``include``, merging, validation
 :mod:`.errors`         every failure as one line ``<file>:<line>: <key.path>: <expected>``
 :mod:`.schema`         the JSON Schema (``pfctl mission schema``)

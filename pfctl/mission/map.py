@@ -11,32 +11,28 @@ from typing import Annotated
 import shapely
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from pfctl.core.mapping.grid import InverseSensorModel
 from pfctl.mission.errors import field_error, raise_first
+from pfctl.mission.params import CoreSection, FromCore
 from pfctl.mission.types import (
-    NO_BOOL,
     TOLERANCE,
     MissionModel,
     Name,
     Point,
     Polygon,
     Positive,
-    Probability,
     existing_file,
     fmt_point,
 )
 
 
-class SensorModel(MissionModel):
+class SensorModel(CoreSection, core=InverseSensorModel):
     """Inverse sensor model of Eq. 1: p(occupied | what the beam did), and the clamping bounds."""
 
-    p_hit: Annotated[float, Field(gt=0.5, lt=1), NO_BOOL] = 0.7
-    """p(occupied | the beam ended in the cell)."""
-    p_miss: Annotated[float, Field(gt=0, lt=0.5), NO_BOOL] = 0.4
-    """p(occupied | the beam passed through the cell)."""
-    p_min: Probability = 0.02
-    """Lower clamp of p(m), so the map can still change its mind."""
-    p_max: Probability = 0.98
-    """Upper clamp of p(m); greater than p_min."""
+    p_hit: FromCore
+    p_miss: FromCore
+    p_min: FromCore
+    p_max: FromCore
 
     @model_validator(mode="after")
     def _bounds_ordered(self) -> SensorModel:

@@ -5,6 +5,10 @@ Each section is a small frozen model whose fields are SI values (``map``: :mod:`
 the robot, its sensors, perception, tracking, belief, prediction, search, control and behavior
 here). :meth:`Mission.layout` turns the ``map`` section into the
 :class:`pfctl.core.mapping.house.HouseLayout` value types.
+
+A key annotated ``FromCore`` is a core parameter: its type, default, bounds and meaning are
+declared once, on the field of the dataclass the section names as ``core``
+(:mod:`pfctl.mission.params`); the app builds that dataclass from the section by name.
 """
 
 from __future__ import annotations
@@ -15,24 +19,32 @@ from typing import Annotated, Literal
 import shapely
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from pfctl.core.behavior.skills import SearchParams
+from pfctl.core.control import ControlParams
+from pfctl.core.follower import FollowerParams, PredictionParams
 from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region
+from pfctl.core.metrics import MetricParams
+from pfctl.core.perception.belief import BeliefParams
+from pfctl.core.perception.clothes import ClothesParams
+from pfctl.core.perception.identity.params import IdentityParams
+from pfctl.core.perception.legs.detector import LegParams
+from pfctl.core.perception.tracking import TrackerParams
+from pfctl.core.prediction.models import SvrState
 from pfctl.mission.backend import BackendConfig
 from pfctl.mission.errors import field_error, raise_first
 from pfctl.mission.map import MapConfig
+from pfctl.mission.params import CoreSection, FromCore
 from pfctl.mission.scenario import ScenarioConfig
 from pfctl.mission.tree import TreeNode, paper_tree
 from pfctl.mission.types import (
     NO_BOOL,
     TOLERANCE,
     Count,
-    Limits,
     MissionModel,
     Name,
     NonNegative,
     Number,
     Positive,
-    Probability,
-    UnitInterval,
     existing_file,
     fmt_point,
 )
@@ -46,18 +58,23 @@ class Pose(MissionModel):
     theta: Number = 0.0
 
 
-class RobotConfig(MissionModel):
+class RobotConfig(
+    CoreSection,
+    core=ControlParams,
+    core_names={
+        "radius": "robot_radius",
+        "head_pan_limits": "pan_limits",
+        "head_tilt_limits": "tilt_limits",
+    },
+):
     """The robot's size and limits; the defaults are the Toyota HSR's (§III-A)."""
 
-    radius: Positive = 0.215
-    max_linear_speed: Positive = 0.22
-    """m/s (omnidirectional base)."""
-    max_angular_speed: Positive = 0.8
-    """rad/s."""
-    head_pan_limits: Limits = (-3.84, 1.75)
-    head_tilt_limits: Limits = (-1.57, 0.52)
-    head_max_speed: Positive = 1.0
-    """rad/s."""
+    radius: FromCore
+    max_linear_speed: FromCore
+    max_angular_speed: FromCore
+    head_pan_limits: FromCore
+    head_tilt_limits: FromCore
+    head_max_speed: FromCore
     start: Pose | None = None
     """Where the robot starts; None: a point inside the first region."""
 
@@ -90,7 +107,7 @@ class LaserConfig(MissionModel):
         return self
 
 
-class CameraConfig(MissionModel):
+class CameraConfig(CoreSection, core=ControlParams, core_names={"mount_height": "camera_height"}):
     """The RGB-D camera on the head (HSR: Xtion PRO LIVE)."""
 
     rate_hz: Positive = 10.0
@@ -99,8 +116,7 @@ class CameraConfig(MissionModel):
     height: Annotated[int, Field(ge=16, le=1080), NO_BOOL] = 240
     hfov_deg: Annotated[float, Field(gt=0, lt=180), NO_BOOL] = 58.0
     """Horizontal field of view, degrees."""
-    mount_height: Positive = 1.05
-    """Height of the head's pan/tilt pivot above the floor, metres."""
+    mount_height: FromCore
     forward_offset: NonNegative = 0.1
     """Distance of the optical centre ahead of the pivot, metres."""
     range_min: Positive = 0.4
@@ -142,29 +158,18 @@ class SensorsConfig(MissionModel):
     pose: PoseNoise = PoseNoise()
 
 
-class LegsConfig(MissionModel):
+class LegsConfig(CoreSection, core=LegParams):
     """Leg detection from the 2-D laser (§II-E; segment features of Arras et al. 2007)."""
 
     model: Path | None = None
     """A model written by ``pfctl legs train`` (relative to the mission file); default: the
     model shipped with pfctl."""
-    probability: Probability = 0.5
-    """Random-forest score above which a laser segment is a leg."""
-    jump_distance: Positive = 0.13
-    """A segment ends where two neighbouring returns are farther apart than this, metres."""
-    min_points: Annotated[int, Field(ge=2), NO_BOOL] = 3
-    """Segments with fewer returns are not classified."""
-    max_range: Positive = 6.0
-    """Segments farther from the laser than this are not classified, metres."""
-    pair_distance: Positive = 0.45
-    """Two legs closer than this form one person candidate, metres. Walking legs are up to
-    ~0.4 m apart at shin height; 0.6 paired the legs of two people passing each other (see
-    tests/app/test_perception.py)."""
-    history_scans: Annotated[int, Field(ge=1, le=100), NO_BOOL] = 10
-    """P(leg) of a segment is averaged over this many scans of its track (1: each scan alone).
-    On the real bags, 10 raised leave-one-bag-out precision from 0.57 to 0.78 and recall from
-    0.51 to 0.54 (``pfctl legs evaluate --history``), and cut the demo replay's track ids from
-    114 to 36 (fewer tracks started by clutter)."""
+    probability: FromCore
+    jump_distance: FromCore
+    min_points: FromCore
+    max_range: FromCore
+    pair_distance: FromCore
+    history_scans: FromCore
 
     @field_validator("model")
     @classmethod
@@ -185,32 +190,20 @@ class VisionConfig(MissionModel):
     """Fewer body pixels than this is no detection."""
 
 
-class IdentityConfig(MissionModel):
+class IdentityConfig(CoreSection, core=(IdentityParams, ClothesParams)):
     """Target identification (Algorithm 2): faces, then clothes histograms."""
 
-    face_distance: Positive = 0.6
-    """Face-embedding distance below which two faces match."""
-    clothes_similarity: UnitInterval = 0.6
-    """Histogram intersection S above which clothes match."""
-    color_space: Literal["hsv", "rgb", "lab"] = "hsv"
-    """Colour space of the clothing histograms."""
-    bins: tuple[Count, Count, Count] = (16, 4, 4)
-    """Histogram bins per channel of ``color_space``."""
+    face_distance: FromCore
+    clothes_similarity: FromCore
+    color_space: FromCore
+    bins: FromCore
     face_worker: bool = True
-    """Search faces (dlib's detector and embedding, ~90 ms per face) in a worker process off the
-    control loop, not inline in the tick (``pfctl follow``/``search`` in the simulator)."""
-    face_timing: Literal["auto", "deterministic", "realtime"] = "auto"
-    """When the worker's results count: ``deterministic`` (a search of the frame at t counts
-    from t + ``face_latency_s``, waiting for the worker if needed: reproducible episodes),
-    ``realtime`` (whatever has come back, never wait), ``auto``: deterministic in the simulator,
-    realtime on a robot."""
-    face_latency_s: NonNegative = 0.1
-    """Deterministic timing: the latency of a face search, seconds (about one embedding)."""
-    face_miss_limit: Count = 3
-    """After this many face searches of a track in a row found no face (the back of the head),
-    its face is searched only every ``face_miss_backoff_s``."""
-    face_miss_backoff_s: NonNegative = 0.5
-    """How often a track whose face searches keep missing is searched again, seconds."""
+    """Search faces (dlib's detector and embedding) in a worker process off the control loop,
+    not inline in the tick (``pfctl follow``/``search`` in the simulator)."""
+    face_timing: FromCore
+    face_latency_s: FromCore
+    face_miss_limit: FromCore
+    face_miss_backoff_s: FromCore
 
 
 class PerceptionConfig(MissionModel):
@@ -221,37 +214,26 @@ class PerceptionConfig(MissionModel):
     identity: IdentityConfig = IdentityConfig()
 
 
-class TrackingConfig(MissionModel):
+class TrackingConfig(CoreSection, core=TrackerParams):
     """Noise of the constant-velocity Kalman filters and the association gate (§II-E)."""
 
-    process_noise: Positive = 0.5
-    """Continuous white-noise acceleration of the constant-velocity model: √(spectral density),
-    i.e. the std of the velocity change over one second (m/s per √s), whatever the sensor rate."""
-    laser_noise: Positive = 0.05
-    """Std of a leg-pair position, m."""
-    camera_noise: Positive = 0.15
-    """Std of a camera position, m."""
-    gate: Positive = 9.21
-    """Squared Mahalanobis gate (chi², 2 dof, 99 %)."""
-    confirm_hits: Count = 3
-    """A tentative track is confirmed after this many associated detections."""
-    tentative_timeout_s: Positive = 0.5
-    """A tentative track unseen for this long is deleted."""
-    max_coast_s: Positive = 1.5
-    """A confirmed track unseen for this long while inside a sensor's field of view is deleted."""
-    max_coast_unseen_s: Positive = 5.0
-    """A confirmed track outside every sensor's field of view coasts this long before deletion."""
+    process_noise: FromCore
+    laser_noise: FromCore
+    camera_noise: FromCore
+    gate: FromCore
+    confirm_hits: FromCore
+    tentative_timeout_s: FromCore
+    max_coast_s: FromCore
+    max_coast_unseen_s: FromCore
 
 
-class BeliefConfig(MissionModel):
+class BeliefConfig(CoreSection, core=BeliefParams):
     """The human belief grid of Eq. 4."""
 
-    prior: Probability = 0.05
-    p_o_given_h: Annotated[float, Field(gt=0, le=1), NO_BOOL] = 0.9
-    """p(person detected | person in the cell)."""
-    p_o_given_not_h: Annotated[float, Field(ge=0, lt=1), NO_BOOL] = 0.05
-    """p(person detected | no person in the cell)."""
-    decay_per_s: NonNegative = 0.0
+    prior: FromCore
+    p_o_given_h: FromCore
+    p_o_given_not_h: FromCore
+    decay_per_s: FromCore
 
     @model_validator(mode="after")
     def _informative(self) -> BeliefConfig:
@@ -264,7 +246,7 @@ class BeliefConfig(MissionModel):
         return self
 
 
-class SvrParams(MissionModel):
+class SvrParams(CoreSection, core=SvrState):
     """Hyper-parameters of the RBF support-vector regressor of ``prediction.model``.
 
     The defaults suit the default model ``svr`` (the paper's C and ε; γ = 0.01 s⁻² tuned on real
@@ -272,63 +254,49 @@ class SvrParams(MissionModel):
     which is ``svr-time``: set ``gamma: 1.0`` (and ``half_life_s: 1.0``) with that model.
     """
 
-    C: Positive = 1000.0
-    epsilon: Positive = 0.01
-    """Half-width of the ε-insensitive tube, metres."""
-    gamma: Positive = 0.01
-    """RBF width parameter, s⁻² (time is in seconds since the last sample)."""
+    C: FromCore
+    epsilon: FromCore
+    gamma: FromCore
 
 
-class Weighting(MissionModel):
+class Weighting(CoreSection, core=SvrState, core_names={"kind": "weighting"}):
     """Sample weights of the trajectory fit: recent samples count more (§II-E)."""
 
-    kind: Literal["none", "linear", "exponential"] = "exponential"
-    half_life_s: Positive = 0.5
-    """Age at which an exponential weight has halved, seconds."""
+    kind: FromCore
+    half_life_s: FromCore
 
 
-class PredictionConfig(MissionModel):
+class PredictionConfig(CoreSection, core=PredictionParams):
     """Trajectory prediction of a lost target (§II-E, §III)."""
 
-    model: Literal["svr", "svr-time", "poly3", "cv"] = "svr"
-    history_s: Positive = 3.0
-    horizon_s: Positive = 3.0
+    model: FromCore
+    history_s: FromCore
+    horizon_s: FromCore
     svr: SvrParams = SvrParams()
     weighting: Weighting = Weighting()
 
 
-class SearchConfig(MissionModel):
+class SearchConfig(CoreSection, core=SearchParams):
     """Frontier map (Eq. 2), utility (Eq. 3) and way-point search (Algorithm 1)."""
 
-    alpha: NonNegative = 0.05
-    """Utility per unknown cell a frontier borders (Eq. 3)."""
-    beta: NonNegative = 1.0
-    """Weight of obstacle boundaries in the frontier map (Eq. 2)."""
-    frontier_threshold: Positive = 0.1
-    """F above which a cell is a frontier cell."""
-    heading_window_s: Positive = 3.0
-    """T: the pose history Algorithm 1 looks back over, s."""
-    min_frontier_cells: Count = 5
-    """Smaller frontier clusters are dropped."""
-    waypoint_choice: Literal["utility", "nearest"] = "utility"
-    """How Algorithm 1 picks the frontier to search: ``utility`` (Eq. 3, the paper) or
-    ``nearest`` (the reachable frontier nearest the robot by path length, whatever its size or
-    l*: the nearest-frontier baseline, ``missions/baselines/``)."""
+    alpha: FromCore
+    beta: FromCore
+    frontier_threshold: FromCore
+    heading_window_s: FromCore
+    min_frontier_cells: FromCore
+    waypoint_choice: FromCore
 
 
-class ControlConfig(MissionModel):
+class ControlConfig(
+    CoreSection, core=(ControlParams, MetricParams), core_names={"following_band": "band"}
+):
     """Gaze and base control while following (§II-E), and what counts as following."""
 
-    following_distance: Annotated[float, Field(ge=0.3), NO_BOOL] = 1.0
-    """Keep this far from the target, metres."""
-    min_distance: Annotated[float, Field(ge=0.3), NO_BOOL] = 0.7
-    """Never drive closer than this to a person (base centre to person centre), metres."""
-    turn_threshold: Annotated[float, Field(gt=0, le=3.2), NO_BOOL] = 0.5
-    """Above this bearing to the target the base turns in place before going straight, rad."""
-    stale_after: Positive = 0.5
-    """The base stops when the laser or the pose is older than this, seconds."""
-    following_band: Limits = (0.5, 2.5)
-    """A tick counts as following when the target is identified and this far away, metres."""
+    following_distance: FromCore
+    min_distance: FromCore
+    turn_threshold: FromCore
+    stale_after: FromCore
+    following_band: FromCore
 
     @model_validator(mode="after")
     def _distances_ordered(self) -> ControlConfig:
@@ -341,10 +309,10 @@ class ControlConfig(MissionModel):
         return self
 
 
-class BehaviorConfig(MissionModel):
+class BehaviorConfig(CoreSection, core=FollowerParams):
     """The behavior tree and its tick rate (§II-A); the default tree is the paper's Fig. 2."""
 
-    tick_hz: Positive = 10.0
+    tick_hz: FromCore
     tree: TreeNode = Field(default_factory=paper_tree)
 
 
