@@ -21,55 +21,33 @@ from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
 from pfctl.core.mapping.regions import RegionMap
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.core.perception.pipeline import Perception
+from pfctl.core.prediction.models import SvrState
 from pfctl.core.robot import STOP, GroundTruth, Robot, RobotLostError
 from pfctl.mission import Mission
 from pfctl.mission.map_server import load_map_server
+from pfctl.mission.params import core_params, core_values
 
 
 def control_params(mission: Mission) -> ControlParams:
     """Gaze and base control (``control``, ``robot``, ``sensors.camera``)."""
-    c, r = mission.control, mission.robot
-    return ControlParams(
-        following_distance=c.following_distance,
-        min_distance=c.min_distance,
-        turn_threshold=c.turn_threshold,
-        max_linear_speed=r.max_linear_speed,
-        max_angular_speed=r.max_angular_speed,
-        robot_radius=r.radius,
-        stale_after=c.stale_after,
-        pan_limits=(r.head_pan_limits[0], r.head_pan_limits[1]),
-        tilt_limits=(r.head_tilt_limits[0], r.head_tilt_limits[1]),
-        head_max_speed=r.head_max_speed,
-        camera_height=mission.sensors.camera.mount_height,
-    )
+    return core_params(ControlParams, mission.control, mission.robot, mission.sensors.camera)
+
+
+def prediction_params(mission: Mission) -> PredictionParams:
+    """The predictor of a lost target (``prediction``); its hyperparameters by their names in
+    the model (``svr`` and ``weighting``, declared by the default model :class:`SvrState`)."""
+    p = mission.prediction
+    return core_params(PredictionParams, p, params=core_values(SvrState, p.svr, p.weighting))
 
 
 def follower_params(mission: Mission) -> FollowerParams:
     """The follower's parameters from the mission."""
-    s, p = mission.search, mission.prediction
-    return FollowerParams(
-        tick_hz=mission.behavior.tick_hz,
+    return core_params(
+        FollowerParams,
+        mission.behavior,
         control=control_params(mission),
-        search=SearchParams(
-            alpha=s.alpha,
-            beta=s.beta,
-            frontier_threshold=s.frontier_threshold,
-            min_frontier_cells=s.min_frontier_cells,
-            heading_window_s=s.heading_window_s,
-            waypoint_choice=s.waypoint_choice,
-        ),
-        prediction=PredictionParams(
-            model=p.model,
-            params={
-                "C": p.svr.C,
-                "epsilon": p.svr.epsilon,
-                "gamma": p.svr.gamma,
-                "weighting": p.weighting.kind,
-                "half_life_s": p.weighting.half_life_s,
-            },
-            history_s=p.history_s,
-            horizon_s=p.horizon_s,
-        ),
+        search=core_params(SearchParams, mission.search),
+        prediction=prediction_params(mission),
     )
 
 
@@ -84,7 +62,6 @@ def build_follower(
     mission: Mission, robot: Robot, perception: Perception, log: EpisodeLog | None = None
 ) -> Follower:
     """The mission's follower on ``robot`` with ``perception``."""
-    sm = mission.map.sensor_model
     grid = static_map(mission)
     regions = RegionMap(mission.layout())
     # cached per geometry (~10 ms): made here, not in the tick of the first prediction or
@@ -97,7 +74,7 @@ def build_follower(
         follower_params(mission),
         static_map=grid,
         regions=regions,
-        sensor_model=InverseSensorModel(sm.p_hit, sm.p_miss, sm.p_min, sm.p_max),
+        sensor_model=core_params(InverseSensorModel, mission.map.sensor_model),
         robot_radius=mission.robot.radius,
         log=log,
     )
@@ -175,6 +152,7 @@ __all__ = [
     "build_follower",
     "control_params",
     "follower_params",
+    "prediction_params",
     "run_follower",
     "static_map",
 ]

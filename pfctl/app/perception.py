@@ -19,45 +19,39 @@ from pfctl.core.perception.belief import BeliefParams, HumanBelief
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.face_worker import FaceWorker
 from pfctl.core.perception.identity.identifier import TargetIdentifier
-from pfctl.core.perception.identity.params import FaceTiming, IdentityParams
+from pfctl.core.perception.identity.params import (
+    FaceTiming,
+    IdentityParams,
+    resolve_face_timing,
+)
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.core.perception.legs.detector import LegDetector, LegParams
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.perception.tracking import MultiPersonTracker, TrackerParams
 from pfctl.core.perception.vision import PersonDetector
 from pfctl.mission import Mission
+from pfctl.mission.params import core_params
 
 
 def leg_params(mission: Mission) -> LegParams:
     """The leg detector's parameters (``perception.legs``)."""
-    c = mission.perception.legs
-    return LegParams(
-        probability=c.probability,
-        jump_distance=c.jump_distance,
-        min_points=c.min_points,
-        max_range=c.max_range,
-        pair_distance=c.pair_distance,
-        history_scans=c.history_scans,
-    )
+    return core_params(LegParams, mission.perception.legs)
 
 
 def tracker_params(mission: Mission) -> TrackerParams:
     """The tracker's parameters (``tracking``)."""
-    return TrackerParams(**mission.tracking.model_dump())
+    return core_params(TrackerParams, mission.tracking)
 
 
 def belief_params(mission: Mission) -> BeliefParams:
     """The human belief's parameters (``belief``)."""
-    return BeliefParams(**mission.belief.model_dump())
+    return core_params(BeliefParams, mission.belief)
 
 
 def face_timing(mission: Mission, robot: Literal["sim", "real"] = "sim") -> FaceTiming:
     """``perception.identity.face_timing`` with ``auto`` resolved: deterministic in the
     simulator (reproducible episodes), realtime on a real robot."""
-    timing = mission.perception.identity.face_timing
-    if timing == "auto":
-        return "deterministic" if robot == "sim" else "realtime"
-    return timing
+    return resolve_face_timing(mission.perception.identity.face_timing, on_robot=robot == "real")
 
 
 def identity_params(
@@ -66,16 +60,11 @@ def identity_params(
     """The identification parameters (``perception.identity``); the face worker's timing for
     ``robot`` (see :func:`face_timing`) unless ``timing`` is given."""
     cfg = mission.perception.identity
-    space: Literal["hsv", "rgb", "lab"] = cfg.color_space
-    h, s, v = (int(b) for b in cfg.bins)
-    return IdentityParams(
-        face_distance=float(cfg.face_distance),
-        clothes_similarity=float(cfg.clothes_similarity),
-        clothes=ClothesParams(space, (h, s, v)),
-        face_miss_limit=int(cfg.face_miss_limit),
-        face_miss_backoff_s=float(cfg.face_miss_backoff_s),
+    return core_params(
+        IdentityParams,
+        cfg,
+        clothes=core_params(ClothesParams, cfg),
         face_timing=timing or face_timing(mission, robot),
-        face_latency_s=float(cfg.face_latency_s),
     )
 
 

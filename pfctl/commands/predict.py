@@ -29,7 +29,9 @@ from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, T
 from rich.table import Table
 from typer.core import TyperGroup
 
+from pfctl.app.follower import prediction_params
 from pfctl.app.trajectory_files import read_csv_trajectory, read_trajectories
+from pfctl.core.follower import PredictionParams
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.regions import RegionMap
@@ -139,14 +141,7 @@ def _mission_params(mission: Mission | None, name: str) -> dict[str, Any]:
     """
     if mission is None or mission.prediction.model != name:
         return {}
-    p = mission.prediction
-    return {
-        "C": p.svr.C,
-        "epsilon": p.svr.epsilon,
-        "gamma": p.svr.gamma,
-        "weighting": p.weighting.kind,
-        "half_life_s": p.weighting.half_life_s,
-    }
+    return dict(prediction_params(mission).params)
 
 
 def _prepare_output(path: Path | None, option: str) -> None:
@@ -273,12 +268,11 @@ def track(
     _positive(step, "--step")
     _positive(history_s, "--history")
     mission = load_mission(mission_file) if mission_file is not None else None
-    name = _check_model(
-        model or (mission.prediction.model if mission is not None else DEFAULT_MODEL)
-    )
+    defaults = prediction_params(mission) if mission is not None else PredictionParams()
+    name = _check_model(model or defaults.model)
     params = _mission_params(mission, name)
-    horizon = horizon or (mission.prediction.horizon_s if mission is not None else 3.0)
-    history_s = history_s or (mission.prediction.history_s if mission is not None else 3.0)
+    horizon = horizon or defaults.horizon_s
+    history_s = history_s or defaults.history_s
     _prepare_output(out, "--out")
     _prepare_output(plot, "--plot")
     full = read_csv_trajectory(track_file, min_points=2)

@@ -26,6 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pfctl.core.mapping.grid import GridGeometry
+from pfctl.core.params import param
 from pfctl.core.robot import STOP, HeadState, HeadTarget, Pose2D, Twist2D, wrap_angle
 
 __all__ = [
@@ -69,41 +70,67 @@ class ControlParams:
     keep it below its top speed.
     """
 
-    following_distance: float = 1.0
-    """Keep this far from the target (base centre to person centre), m."""
-    min_distance: float = 0.7
-    """Never closer than this to any person's centre, m: inside it, no motion toward them."""
-    turn_threshold: float = 0.5
-    """|bearing| above this: TURN in place; below: GO_STRAIGHT, rad."""
+    following_distance: float = param(
+        1.0, "Keep this far from the target (base centre to person centre).", unit="m", ge=0.3
+    )
+    min_distance: float = param(
+        0.7,
+        "Never drive closer than this to a person (base centre to person centre): inside it, no"
+        " motion toward them.",
+        unit="m",
+        ge=0.3,
+    )
+    turn_threshold: float = param(
+        0.5,
+        "Above this bearing to the target the base turns in place (TURN), below it goes straight"
+        " (GO_STRAIGHT).",
+        unit="rad",
+        gt=0,
+        le=3.2,
+    )
     k_turn: float = 1.5
     """Turn rate per radian of bearing, rad/s per rad."""
     k_distance: float = 0.8
     """Forward speed per metre beyond the following (or minimum) distance, m/s per m."""
-    max_linear_speed: float = 0.22
-    """m/s (norm of vx, vy)."""
-    max_angular_speed: float = 0.8
-    """rad/s."""
-    robot_radius: float = 0.215
-    """Half-width of the corridor the line-of-sight check keeps free, m."""
+    max_linear_speed: float = param(
+        0.22, "Top speed of the omnidirectional base (norm of vx, vy).", unit="m/s", gt=0
+    )
+    max_angular_speed: float = param(0.8, "Top turn rate of the base.", unit="rad/s", gt=0)
+    robot_radius: float = param(
+        0.215,
+        "Radius of the robot's footprint: planning keeps it clear of obstacles, and the"
+        " line-of-sight check a corridor that wide.",
+        unit="m",
+        gt=0,
+    )
     person_radius: float = 0.35
     """Occupied cells this close to the target's centre are its legs: the line-of-sight check
     never looks there, m."""
-    stale_after: float = 0.5
-    """Laser or pose older than this: stop, s."""
-    pan_limits: tuple[float, float] = (-3.84, 1.75)
-    """Head pan joint limits, rad (HSR: asymmetric)."""
-    tilt_limits: tuple[float, float] = (-1.57, 0.52)
-    """Head tilt joint limits, rad (down negative)."""
-    head_max_speed: float = 1.0
-    """Head joint speed limit, rad/s."""
+    stale_after: float = param(
+        0.5, "The base stops when the laser or the pose is older than this.", unit="s", gt=0
+    )
+    pan_limits: tuple[float, float] = param(
+        (-3.84, 1.75),
+        "Head pan joint limits [low, high] (HSR: asymmetric).",
+        unit="rad",
+        ordered=True,
+    )
+    tilt_limits: tuple[float, float] = param(
+        (-1.57, 0.52),
+        "Head tilt joint limits [low, high] (down negative).",
+        unit="rad",
+        ordered=True,
+    )
+    head_max_speed: float = param(1.0, "Head joint speed limit.", unit="rad/s", gt=0)
     head_kp: float = 8.0
     """Proportional gain of the head PD law, 1/s."""
     head_kd: float = 0.1
     """Derivative gain of the head PD law (rad/s per rad/s, dimensionless)."""
     head_lead: float = 0.4
     """How far ahead of the measured angle the head command may run, in seconds of top speed."""
-    camera_height: float = 1.05
-    """Height of the pan/tilt pivot above the floor, m."""
+    camera_height: float = param(
+        1.05, "Height of the head's pan/tilt pivot above the floor.", unit="m", gt=0
+    )
     look_height: float = 1.1
     """Aim at this height on a person (torso / face), m."""
 

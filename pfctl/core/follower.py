@@ -49,10 +49,17 @@ from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
 from pfctl.core.mapping.paths import line_of_sight
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.params import param
 from pfctl.core.perception.identity.identifier import Decision
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.clipping import clip_prediction
-from pfctl.core.prediction.models import MIN_POINTS, PredictionError, make_model
+from pfctl.core.prediction.models import (
+    DEFAULT_MODEL,
+    MIN_POINTS,
+    ModelName,
+    PredictionError,
+    make_model,
+)
 from pfctl.core.robot import STOP, Observation, Robot
 
 #: Belief peaks considered for the gaze (the best one away from known people wins).
@@ -63,10 +70,18 @@ PEAK_CANDIDATES = 8
 class PredictionParams:
     """The predictor used when the target is lost (§II-E; the mission's ``prediction``)."""
 
-    model: str = "svr"
+    model: ModelName = param(
+        DEFAULT_MODEL,
+        "The predictor (README, ``pfctl predict``): ``svr`` (the paper's weighted SVR as a state"
+        " estimator, then constant velocity), ``svr-time`` (the paper's SVR over time),"
+        " ``poly3`` (the paper's weighted cubic polynomial) or ``cv`` (constant velocity).",
+    )
     params: Mapping[str, Any] = field(default_factory=dict)
-    history_s: float = 3.0
-    horizon_s: float = 3.0
+    """The model's hyperparameters by name (``make_model``)."""
+    history_s: float = param(
+        3.0, "The target's detected path of this long before the loss is fitted.", unit="s", gt=0
+    )
+    horizon_s: float = param(3.0, "How far ahead the prediction reaches.", unit="s", gt=0)
     step_s: float = 0.25
     """Spacing of the predicted points, s."""
 
@@ -75,7 +90,9 @@ class PredictionParams:
 class FollowerParams:
     """Everything the follower needs besides the robot, the perception and the tree."""
 
-    tick_hz: float = 10.0
+    tick_hz: float = param(
+        10.0, "Ticks of the behavior tree (and control periods) per second.", unit="Hz", gt=0
+    )
     control: ControlParams = field(default_factory=ControlParams)
     search: SearchParams = field(default_factory=SearchParams)
     prediction: PredictionParams = field(default_factory=PredictionParams)

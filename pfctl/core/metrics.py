@@ -66,6 +66,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pfctl.core.episode import HAS_TARGET, EpisodeLog
+from pfctl.core.params import param
 
 FloatArray = NDArray[np.float64]
 BoolArray = NDArray[np.bool_]
@@ -84,8 +85,13 @@ _EPS = 1e-9
 class MetricParams:
     """Thresholds of the metrics (see the module docstring)."""
 
-    band: tuple[float, float] = (0.5, 2.5)
-    """The true robot–target distance counted as "following", m (closed interval)."""
+    band: tuple[float, float] = param(
+        (0.5, 2.5),
+        "A tick counts as following when the target is identified and its true distance from the"
+        " robot lies in this closed interval [low, high].",
+        unit="m",
+        ordered=True,
+    )
     match_radius: float = 0.8
     """A track within this of a person is that person, m."""
     min_loss_s: float = 1.0

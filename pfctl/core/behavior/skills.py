@@ -32,6 +32,7 @@ from pfctl.core.control import (
 from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, WaypointChoice, WaypointDecision, waypoint_search
+from pfctl.core.params import param
 from pfctl.core.robot import STOP, HeadState, HeadTarget, NavStatus, Pose2D, Robot, Twist2D
 
 #: A new MOVE_BASE goal is sent only when it moved farther than this from the one being driven to.
@@ -46,14 +47,19 @@ _OCCUPIED_LOGODDS = float(logit(OCCUPIED_THRESH))
 class SearchParams:
     """Eq. 2, Eq. 3 and Algorithm 1 settings (the mission's ``search`` section)."""
 
-    alpha: float = 0.05
-    beta: float = 1.0
-    frontier_threshold: float = 0.1
-    min_frontier_cells: int = 5
-    heading_window_s: float = 3.0
-    waypoint_choice: WaypointChoice = "utility"
-    """``utility`` (Eq. 3, the paper) or ``nearest`` (the nearest reachable frontier, a
-    baseline; :func:`~pfctl.core.mapping.regions.waypoint_search`)."""
+    alpha: float = param(0.05, "Utility per unknown cell a frontier borders (Eq. 3).", ge=0)
+    beta: float = param(1.0, "Weight of obstacle boundaries in the frontier map (Eq. 2).", ge=0)
+    frontier_threshold: float = param(0.1, "F above which a cell is a frontier cell.", gt=0)
+    min_frontier_cells: int = param(5, "Smaller frontier clusters are dropped.", ge=1)
+    heading_window_s: float = param(
+        3.0, "T: the pose history Algorithm 1 looks back over.", unit="s", gt=0
+    )
+    waypoint_choice: WaypointChoice = param(
+        "utility",
+        "How Algorithm 1 picks the frontier to search: ``utility`` (Eq. 3, the paper) or"
+        " ``nearest`` (the reachable frontier nearest the robot by path length, whatever its size"
+        " or l*: the nearest-frontier baseline, ``missions/baselines/``).",
+    )
 
 
 class Skills:

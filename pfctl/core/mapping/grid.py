@@ -23,6 +23,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.special import entr
 
+from pfctl.core.params import param
+
 FREE = 0
 OCCUPIED = 1
 UNKNOWN = -1
@@ -103,8 +105,7 @@ class InverseSensorModel:
     """Inverse sensor model p(m | z_t) of a laser beam, and the bounds of the Bayes filter (Eq. 1).
 
     A cell where a beam ends (a valid return) is occupied with probability ``p_hit``; a cell a beam
-    passes through is occupied with probability ``p_miss``. These are the mission's
-    ``map.sensor_model``.
+    passes through is occupied with probability ``p_miss`` (the mission's ``map.sensor_model``).
 
     Eq. 1 of the paper is the binary Bayes filter of one cell m::
 
@@ -121,10 +122,12 @@ class InverseSensorModel:
     ``[logit(p_min), logit(p_max)]`` so that a cell can always change its mind again (a door opens).
     """
 
-    p_hit: float = 0.7
-    p_miss: float = 0.4
-    p_min: float = 0.02
-    p_max: float = 0.98
+    p_hit: float = param(0.7, "p(occupied | the beam ended in the cell).", gt=0.5, lt=1)
+    p_miss: float = param(0.4, "p(occupied | the beam passed through the cell).", gt=0, lt=0.5)
+    p_min: float = param(
+        0.02, "Lower clamp of p(m), so that a cell can always change its mind again.", gt=0, lt=1
+    )
+    p_max: float = param(0.98, "Upper clamp of p(m); greater than p_min.", gt=0, lt=1)
 
     def __post_init__(self) -> None:
         for name in ("p_hit", "p_miss", "p_min", "p_max"):

@@ -49,6 +49,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pfctl.core.mapping.grid import GridGeometry
+from pfctl.core.params import param
 from pfctl.core.perception.tracking import FieldOfView
 
 #: Coarsest angle between two visibility rays, radians (finer when a cell at the far range is
@@ -66,20 +67,16 @@ __all__ = [
 
 @dataclass(frozen=True)
 class BeliefParams:
-    """Parameters of Eq. 4 and of the grid's housekeeping (mission ``belief``).
+    """Parameters of Eq. 4 and of the grid's housekeeping (mission ``belief``)."""
 
-    The first four fields are the mission's ``belief`` section by name, so
-    ``BeliefParams(**mission.belief.model_dump())`` builds them.
-    """
-
-    prior: float = 0.05
-    """P(h) of a cell nobody has looked at."""
-    p_o_given_h: float = 0.9
-    """P(o | h): a person in the cell is detected."""
-    p_o_given_not_h: float = 0.05
-    """P(o | hᶜ): a person is detected although the cell is empty."""
-    decay_per_s: float = 0.0
-    """Rate of the exponential return toward the prior, 1/s (0 = none)."""
+    prior: float = param(0.05, "P(h): a person is in a cell nobody has looked at.", gt=0, lt=1)
+    p_o_given_h: float = param(0.9, "P(o | h): a person in the cell is detected.", gt=0, le=1)
+    p_o_given_not_h: float = param(
+        0.05, "P(o | hᶜ): a person is detected although the cell is empty.", ge=0, lt=1
+    )
+    decay_per_s: float = param(
+        0.0, "Rate of the exponential return toward the prior (0: none).", unit="1/s", ge=0
+    )
     p_min: float = 0.001
     p_max: float = 0.999
     detection_radius: float = 0.3

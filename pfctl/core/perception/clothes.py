@@ -26,6 +26,7 @@ from typing import Literal
 
 import numpy as np
 
+from pfctl.core.params import param
 from pfctl.core.perception.faces import Box
 
 ColorSpace = Literal["hsv", "rgb", "lab"]
@@ -48,8 +49,10 @@ _RANGES: dict[str, list[float]] = {
 class ClothesParams:
     """Colour space and bins of the clothing histograms (``perception.identity``)."""
 
-    color_space: ColorSpace = "hsv"
-    bins: tuple[int, int, int] = (16, 4, 4)
+    color_space: ColorSpace = param("hsv", "Colour space of the clothing histograms.")
+    bins: tuple[int, int, int] = param(
+        (16, 4, 4), "Histogram bins per channel of ``color_space``.", ge=1
+    )
 
     @property
     def size(self) -> int:

@@ -67,6 +67,7 @@ from filterpy.kalman import KalmanFilter
 from numpy.typing import ArrayLike, NDArray
 from scipy.optimize import linear_sum_assignment
 
+from pfctl.core.params import param
 from pfctl.core.robot import LaserScan, Pose2D, RgbdFrame, wrap_angle
 
 LASER = "laser"
@@ -181,25 +182,40 @@ class FieldOfView:
 
 @dataclass(frozen=True)
 class TrackerParams:
-    """Noise, gate and life cycle of :class:`MultiPersonTracker` (mission ``tracking``).
+    """Noise, gate and life cycle of :class:`MultiPersonTracker` (mission ``tracking``)."""
 
-    The first eight fields are the mission's ``tracking`` section by name, so
-    ``TrackerParams(**mission.tracking.model_dump())`` builds them.
-    """
-
-    process_noise: float = 0.5
-    """White-noise acceleration: √(spectral density), m/s^1.5 — the std of the velocity change
-    over one second (the mission calls it the acceleration std, m/s²; same number)."""
-    laser_noise: float = 0.05
-    """Std of a laser (leg pair) position, m."""
-    camera_noise: float = 0.15
-    """Std of a camera position, m."""
-    gate: float = 9.21
-    """Squared Mahalanobis gate (χ², 2 dof, 99 %)."""
-    confirm_hits: int = 3
-    tentative_timeout_s: float = 0.5
-    max_coast_s: float = 1.5
-    max_coast_unseen_s: float = 5.0
+    process_noise: float = param(
+        0.5,
+        "Continuous white-noise acceleration of the constant-velocity model: √(spectral density),"
+        " i.e. the std of the velocity change over one second, whatever the sensor rate.",
+        unit="m/s^1.5",
+        gt=0,
+    )
+    laser_noise: float = param(0.05, "Std of a laser (leg pair) position.", unit="m", gt=0)
+    camera_noise: float = param(0.15, "Std of a camera position.", unit="m", gt=0)
+    gate: float = param(
+        9.21,
+        "Squared Mahalanobis distance within which a detection may join a track (χ², 2 dof, 99 %).",
+        gt=0,
+    )
+    confirm_hits: int = param(
+        3, "A tentative track is confirmed after this many associated detections.", ge=1
+    )
+    tentative_timeout_s: float = param(
+        0.5, "A tentative track unseen for this long is deleted.", unit="s", gt=0
+    )
+    max_coast_s: float = param(
+        1.5,
+        "A confirmed track unseen for this long while inside a sensor's field of view is deleted.",
+        unit="s",
+        gt=0,
+    )
+    max_coast_unseen_s: float = param(
+        5.0,
+        "A confirmed track outside every sensor's field of view coasts this long before deletion.",
+        unit="s",
+        gt=0,
+    )
     initial_speed_std: float = 1.0
     """Std of each velocity component of a new track, m/s (people walk at up to ~1.5 m/s)."""
     spawn_sensors: tuple[str, ...] = SENSORS

@@ -50,11 +50,14 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from sklearn.svm import SVR
 
+from pfctl.core.params import param
+
 __all__ = [
     "DEFAULT_MODEL",
     "MIN_POINTS",
     "MODELS",
     "ConstantVelocity",
+    "ModelName",
     "Poly3",
     "PredictionError",
     "Predictor",
@@ -70,6 +73,8 @@ __all__ = [
 
 FloatArray = NDArray[np.float64]
 Weighting = Literal["none", "linear", "exponential"]
+ModelName = Literal["svr", "svr-time", "poly3", "cv"]
+"""The predictors by their CLI/mission names (:data:`MODELS`)."""
 
 
 class PredictionError(ValueError):
@@ -365,11 +370,26 @@ class SvrState(SvrTime):
     predict" and benchmarks/README.md have the numbers.
     """
 
-    C: float = 1000.0
-    epsilon: float = 0.01
-    gamma: float = 0.01
-    weighting: Weighting = "exponential"
-    half_life_s: float = 0.5
+    C: float = param(
+        1000.0,
+        "Penalty of the fit's errors, per second of track (the same at any sampling rate).",
+        gt=0,
+    )
+    epsilon: float = param(0.01, "Half-width of the ε-insensitive tube.", unit="m", gt=0)
+    gamma: float = param(
+        0.01,
+        "RBF width parameter (time is in seconds since the last sample).",
+        unit="s⁻²",
+        gt=0,
+    )
+    weighting: Weighting = param(
+        "exponential",
+        "Sample weights of the fit, recent samples counting more: ``exponential`` (halved every"
+        " ``half_life_s``), ``linear`` (from 0.1 at the oldest sample to 1) or ``none``.",
+    )
+    half_life_s: float = param(
+        0.5, "Age at which an exponential weight has halved.", unit="s", gt=0
+    )
 
     def fit(self, t: ArrayLike, xy: ArrayLike, weights: ArrayLike | None = None) -> SvrState:
         self._fit_svrs(t, xy, weights)

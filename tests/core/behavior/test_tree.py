@@ -21,7 +21,7 @@ from py_trees.common import Status
 from pfctl.core.behavior.registry import LEAF_SPECS
 from pfctl.core.behavior.tree import SimTimeout, build_tree, parse_layout
 from pfctl.mission import load_mission
-from pfctl.mission.models import _paper_tree
+from pfctl.mission.tree import paper_tree
 from pfctl.plots.behavior_tree import ascii_tree, btcpp_xml, dot_tree, png_tree
 from tests.conftest import HOUSE_MISSION
 
@@ -78,7 +78,7 @@ def tick(root: Behaviour, times: int = 1) -> Status:
 
 
 def paper_layout() -> dict[str, Any]:
-    return _paper_tree().model_dump(exclude_none=True)
+    return paper_tree().model_dump(exclude_none=True)
 
 
 def seq(*children: dict[str, Any], memory: bool = False) -> dict[str, Any]:

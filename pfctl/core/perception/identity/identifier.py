@@ -41,6 +41,9 @@ meanwhile is skipped). How results are folded in is ``face_timing``:
   seeded simulation gives the same episode however fast the machine is;
 - ``realtime`` (a real robot): whatever has come back is folded in at each observation, nothing
   waits; a search the worker refuses (it is busy) is tried again on a later frame.
+
+``auto``, which the app resolves for the robot it runs on, counts as ``deterministic`` here
+(:attr:`~pfctl.core.perception.identity.params.IdentityParams.timing`).
 """
 
 from __future__ import annotations
@@ -180,7 +183,7 @@ class TargetIdentifier:
     are measured every time.
 
     ``worker`` (a :class:`~pfctl.core.perception.face_worker.FaceWorker`): faces are searched there,
-    with ``params.face_timing``; without one they are searched inline with ``encoder`` (default: a
+    with ``params.timing``; without one they are searched inline with ``encoder`` (default: a
     :class:`~pfctl.core.perception.faces.FaceEncoder` of ``params.face``). :meth:`close` closes the
     worker.
     """
@@ -195,7 +198,7 @@ class TargetIdentifier:
     ) -> None:
         self.params = params or IdentityParams(clothes=profile.clothes)
         profile.check_params(self.params)
-        if self.params.face_timing not in ("deterministic", "realtime"):
+        if self.params.face_timing not in ("auto", "deterministic", "realtime"):
             raise ValueError(f"face_timing: unknown {self.params.face_timing!r}")
         self.profile = profile
         use_faces = self.params.faces and len(profile.faces) > 0
@@ -295,7 +298,7 @@ class TargetIdentifier:
         for result in self.worker.poll():
             if result.job in self._jobs:  # not another identifier's
                 self._arrived[result.job] = result  # type: ignore[index]
-        if self.params.face_timing == "deterministic":
+        if self.params.timing == "deterministic":
             due = [j for j in self._jobs.values() if j.due <= t + STAMP_EPS]
             for job in due:
                 result = self._arrived.pop(job.job, None)
@@ -368,15 +371,13 @@ class TargetIdentifier:
             self.face_stats.inline += 1
             self._fold_faces(ev, t, self.encoder.detect(rgb, region), t)
             return
-        if self.params.face_timing == "deterministic" and len(self._jobs) >= (
-            self.worker.max_in_flight
-        ):
+        if self.params.timing == "deterministic" and len(self._jobs) >= (self.worker.max_in_flight):
             self.face_stats.deferred += 1
             return
         job = (self._key, self._next_job)
         if not self.worker.submit(job, rgb, region):
             self.face_stats.refused += 1
-            if self.params.face_timing == "realtime":
+            if self.params.timing == "realtime":
                 return  # busy: the track is tried again on a later frame
             # deterministic: only someone else's jobs can fill the worker; wait for a slot
             self.worker.wait_slot()

@@ -6,21 +6,27 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Literal
 
+from pfctl.core.params import param
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.faces import FaceParams
 
 FaceTiming = Literal["deterministic", "realtime"]
 """When a face worker's results are folded in (:mod:`pfctl.core.perception.identity.identifier`)."""
+FaceTimingSetting = Literal["auto", "deterministic", "realtime"]
+""":data:`FaceTiming`, or ``auto``: ``deterministic`` in the simulator, ``realtime`` on a robot
+(:func:`resolve_face_timing`)."""
 
 
 @dataclass(frozen=True)
 class IdentityParams:
     """Thresholds of Algorithm 2 and how appearances are measured (``perception.identity``)."""
 
-    face_distance: float = 0.6
-    """Face-embedding distance below which faces match (dlib's operating point)."""
-    clothes_similarity: float = 0.6
-    """Histogram intersection S at or above which clothes match."""
+    face_distance: float = param(
+        0.6, "Face-embedding distance below which two faces match (dlib's operating point).", gt=0
+    )
+    clothes_similarity: float = param(
+        0.6, "Histogram intersection S at or above which clothes match.", ge=0, le=1
+    )
     clothes: ClothesParams = field(default_factory=ClothesParams)
     face: FaceParams = field(default_factory=FaceParams)
     faces: bool = True
@@ -30,11 +36,15 @@ class IdentityParams:
     ``face_recheck_s`` (an embedding costs ~90 ms on one core; see benchmarks/bench_identity)."""
     face_recheck_s: float = 1.0
     """How often a settled track's face is embedded again, seconds."""
-    face_miss_limit: int = 3
-    """After this many face searches in a row found no face (the back of the head), the track
-    is searched only every ``face_miss_backoff_s`` until a face is found again."""
-    face_miss_backoff_s: float = 0.5
-    """How often a track whose face searches keep missing is searched, seconds."""
+    face_miss_limit: int = param(
+        3,
+        "After this many face searches of a track in a row found no face (the back of the head),"
+        " its face is searched only every ``face_miss_backoff_s`` until one is found again.",
+        ge=1,
+    )
+    face_miss_backoff_s: float = param(
+        0.5, "How often a track whose face searches keep missing is searched again.", unit="s", ge=0
+    )
     clothes_settled: int = 10
     """A track with this many clothes samples is settled when a face decides it or its mean
     similarity is at least ``clothes_margin`` from ``clothes_similarity``
@@ -43,11 +53,34 @@ class IdentityParams:
     """How far from the threshold a settled track's mean clothes similarity is."""
     clothes_recheck_s: float = 0.5
     """How often a settled track's clothes are measured, seconds (0: every observation)."""
-    face_timing: FaceTiming = "deterministic"
-    """With a face worker: ``deterministic`` (simulator) or ``realtime`` (robot)."""
-    face_latency_s: float = 0.1
-    """With a face worker in ``deterministic`` timing: a search of the frame stamped t counts
-    from the first observation stamped t + this (about what an embedding takes)."""
+    face_timing: FaceTimingSetting = param(
+        "auto",
+        "When a face worker's results count: ``deterministic`` (a search of the frame at t counts"
+        " from t + ``face_latency_s``, waiting for the worker if needed: reproducible episodes),"
+        " ``realtime`` (whatever has come back, never wait), ``auto``: deterministic in the"
+        " simulator, realtime on a robot.",
+    )
+    face_latency_s: float = param(
+        0.1,
+        "Deterministic timing: the latency of a face search (about one embedding).",
+        unit="s",
+        ge=0,
+    )
+
+    @property
+    def timing(self) -> FaceTiming:
+        """``face_timing`` as the identifier applies it: ``auto`` is ``deterministic`` there,
+        since the identifier knows no robot (the app resolves ``auto`` for a real one first,
+        :func:`resolve_face_timing`)."""
+        return "realtime" if self.face_timing == "realtime" else "deterministic"
 
 
-__all__ = ["FaceTiming", "IdentityParams"]
+def resolve_face_timing(setting: FaceTimingSetting, on_robot: bool) -> FaceTiming:
+    """``setting`` with ``auto`` resolved: ``deterministic`` in the simulator (reproducible
+    episodes), ``realtime`` on a real robot (the loop never waits for the worker)."""
+    if setting == "auto":
+        return "realtime" if on_robot else "deterministic"
+    return setting
+
+
+__all__ = ["FaceTiming", "FaceTimingSetting", "IdentityParams", "resolve_face_timing"]

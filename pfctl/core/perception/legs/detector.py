@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from pfctl.core.params import param
 from pfctl.core.perception.legs.evidence import LegEvidence
 from pfctl.core.perception.legs.features import (
     FEATURE_NAMES,
@@ -52,21 +53,33 @@ _DISTANCE = FEATURE_NAMES.index("distance")
 class LegParams:
     """Detector parameters (the mission's ``perception.legs``)."""
 
-    probability: float = 0.5
-    """P(leg) at or above which a segment is a leg."""
-    jump_distance: float = 0.13
-    """Neighbouring returns farther apart than this start a new segment, metres."""
-    min_points: int = 3
-    """Segments with fewer returns are not classified."""
-    max_range: float = 6.0
-    """Segments whose centroid is farther from the laser than this are not classified, metres."""
-    pair_distance: float = 0.45
-    """Two legs closer than this are one person, metres."""
+    probability: float = param(
+        0.5, "P(leg), the random forest's score, at or above which a segment is a leg.", gt=0, lt=1
+    )
+    jump_distance: float = param(
+        0.13,
+        "A segment ends where two neighbouring returns are farther apart than this.",
+        unit="m",
+        gt=0,
+    )
+    min_points: int = param(3, "Segments with fewer returns are not classified.", ge=2)
+    max_range: float = param(
+        6.0,
+        "Segments whose centroid is farther from the laser than this are not classified.",
+        unit="m",
+        gt=0,
+    )
+    pair_distance: float = param(
+        0.45, "Two legs closer than this form one person candidate.", unit="m", gt=0
+    )
     single_leg_probability: float = 0.8
     """A leg without a partner is still a person candidate when its P(leg) is at least this."""
-    history_scans: int = 10
-    """P(leg) is the mean over this many scans of the segment's track (1: this scan alone;
-    :class:`~pfctl.core.perception.legs.evidence.LegEvidence`)."""
+    history_scans: int = param(
+        10,
+        "P(leg) of a segment is averaged over this many scans of its track (1: each scan alone).",
+        ge=1,
+        le=100,
+    )
 
 
 @dataclass(frozen=True)
