@@ -1,8 +1,9 @@
 """The condition and action leaves of the behavior tree (§II-A, Fig. 2), on py_trees.
 
-Every leaf reads the follower's state from the blackboard keys of
-:mod:`pfctl.core.behavior.blackboard` (declared per leaf) and acts through the ``skills`` key
-(:class:`~pfctl.core.behavior.skills.Skills`). The statuses are honest: a condition is SUCCESS
+Every leaf reads the follower's state and world model from the blackboard keys of
+:mod:`pfctl.core.behavior.blackboard` (declared per leaf) and writes what the robot should do into
+the ``intents`` key (:class:`~pfctl.core.behavior.intents.Intents`); no leaf commands the robot:
+the follower's act stage sends the tick's intents. The statuses are honest: a condition is SUCCESS
 or FAILURE at once; an action is RUNNING while it works (a navigation in progress is running),
 SUCCESS when it has done its job, FAILURE when it cannot. An action that drives the base gives it
 up in ``terminate`` — also when a higher-priority branch preempts it (status INVALID).
@@ -25,8 +26,9 @@ import py_trees
 from py_trees.common import Access, Status
 
 from pfctl.core.behavior.blackboard import PredictionState, Sighting, TargetState
-from pfctl.core.behavior.skills import Skills
+from pfctl.core.behavior.intents import Intents
 from pfctl.core.behavior.spec import LeafSpec, param
+from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.regions import WaypointDecision
 
@@ -38,7 +40,15 @@ class Leaf(py_trees.behaviour.Behaviour):
     does and its parameters (the registry and the mission's JSON Schema come from these)."""
 
     spec: ClassVar[LeafSpec]
-    reads: ClassVar[tuple[str, ...]] = ("t", "pose", "target", "last_seen", "prediction", "skills")
+    reads: ClassVar[tuple[str, ...]] = (
+        "t",
+        "pose",
+        "target",
+        "last_seen",
+        "prediction",
+        "world",
+        "intents",
+    )
     writes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
@@ -72,8 +82,13 @@ class Leaf(py_trees.behaviour.Behaviour):
         return value
 
     @property
-    def skills(self) -> Skills:
-        value: Skills = self.bb.skills
+    def world(self) -> WorldModel:
+        value: WorldModel = self.bb.world
+        return value
+
+    @property
+    def intents(self) -> Intents:
+        value: Intents = self.bb.intents
         return value
 
     def visible(self, max_age: float = 0.5) -> bool:
@@ -174,10 +189,10 @@ class NearTarget(Leaf):
 
 
 class Action(Leaf):
-    """An action: it names itself to the skills while it runs and gives up the base at the end."""
+    """An action: it names itself in the intents while it runs and gives up the base at the end."""
 
     def update(self) -> Status:
-        self.skills.claim(self.name)
+        self.intents.claim(self.name)
         return self.act()
 
     def act(self) -> Status:
@@ -185,7 +200,7 @@ class Action(Leaf):
 
     def terminate(self, new_status: Status) -> None:
         if new_status in (Status.INVALID, Status.FAILURE):
-            self.skills.release()
+            self.intents.release()
 
 
 class FollowTarget(Action):
@@ -211,7 +226,7 @@ class FollowTarget(Action):
         target = self.target
         if target is None:
             return Status.FAILURE
-        self.skills.follow(target.xy, self.params["distance"])
+        self.intents.follow(target.xy, self.params["distance"])
         return Status.RUNNING
 
 
@@ -228,7 +243,7 @@ class GazeAtTarget(Action):
         target = self.target
         if target is None:
             return Status.FAILURE
-        self.skills.look_at(target.xy, "target")
+        self.intents.look_at(target.xy, "target")
         return Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
@@ -254,7 +269,7 @@ class GoToPrediction(Action):
             return Status.FAILURE
         if p.reached:
             return Status.SUCCESS
-        outcome = self.skills.go_to(p.goal, self.params["tolerance"])
+        outcome = self.intents.go_to(p.goal, self.params["tolerance"])
         if outcome == "arrived":
             p.reached = True
             return Status.SUCCESS
@@ -292,14 +307,14 @@ class LookAround(Action):
         if elapsed >= seconds:
             if self.prediction is not None:
                 self.prediction.used = True
-            self.skills.stop()
+            self.intents.stop()
             return Status.FAILURE
-        self.skills.set_pan(sweep_pan(elapsed, seconds, float(self.params["pan"])))
+        self.intents.set_pan(sweep_pan(elapsed, seconds, float(self.params["pan"])))
         if self.params["turn"]:
-            wz = min(2.0 * math.pi / seconds, self.skills.control.max_angular_speed)
-            self.skills.turn(wz)
+            wz = min(2.0 * math.pi / seconds, self.intents.control.max_angular_speed)
+            self.intents.turn(wz)
         else:
-            self.skills.stop()
+            self.intents.stop()
         return Status.RUNNING
 
 
@@ -320,6 +335,7 @@ class WaypointSearch(Action):
         "running until the target is found, failure when nothing is left to search.",
         (param("tolerance", 0.4, "arrival distance at a way-point, m", minimum=0.05),),
     )
+    writes = ("waypoint",)
 
     REPLAN_S: ClassVar[float] = 3.0
     #: A frontier goal this close to a visited way-point counts as visited, metres.
@@ -338,7 +354,8 @@ class WaypointSearch(Action):
     def _decide(self) -> WaypointDecision:
         seen = self.last_seen
         history = seen.history if seen is not None else np.empty((0, 3))
-        decision = self._unvisited(self.skills.next_waypoint(history))
+        pose = self.bb.pose
+        decision = self._unvisited(self.world.next_waypoint(history, (pose.x, pose.y)))
         self._decided_at = self.t
         current = self._decision
         keep = None
@@ -354,7 +371,7 @@ class WaypointSearch(Action):
         if keep is not None:
             decision = _with_waypoint(decision, keep)
         self._decision = decision
-        self.skills.waypoint = decision
+        self.bb.waypoint = decision
         return decision
 
     def _unvisited(self, decision: WaypointDecision) -> WaypointDecision:
@@ -409,7 +426,7 @@ class WaypointSearch(Action):
             decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        outcome = self.skills.go_to(decision.waypoint, self.params["tolerance"])
+        outcome = self.intents.go_to(decision.waypoint, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING
         self._visited.append(decision.waypoint)
@@ -418,8 +435,8 @@ class WaypointSearch(Action):
         decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        if self.skills.go_to(decision.waypoint, self.params["tolerance"]) != "running":
-            self.skills.turn(self.skills.control.max_angular_speed * 0.5)
+        if self.intents.go_to(decision.waypoint, self.params["tolerance"]) != "running":
+            self.intents.turn(self.intents.control.max_angular_speed * 0.5)
         return Status.RUNNING
 
 
@@ -455,7 +472,7 @@ class GoToLastSeen(Action):
             return Status.FAILURE
         if self._outcome is not None and self._outcome[0] == seen.t:
             return self._outcome[1]
-        outcome = self.skills.go_to(seen.xy, self.params["tolerance"])
+        outcome = self.intents.go_to(seen.xy, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING
         status = Status.SUCCESS if outcome == "arrived" else Status.FAILURE
@@ -469,7 +486,7 @@ class Stop(Action):
     spec = LeafSpec("stop", "action", "Stop the base; success.")
 
     def act(self) -> Status:
-        self.skills.stop()
+        self.intents.stop()
         return Status.SUCCESS
 
 
