@@ -20,7 +20,7 @@ the worker); ``--timing deterministic`` uses the simulator's reproducible timing
 for a result that is due); ``--no-pace`` runs as fast as it can.
 
 It reports the median, 90th and 99th percentile and maximum wall time of one follower tick
-(:attr:`EpisodeResult.tick_seconds`: observe → perceive → map → behavior tree → act → log; the
+(:attr:`EpisodeResult.tick_seconds`: observe → perceive → predict → decide → act → log; the
 simulator's step, camera rendering and MOVE_BASE's path planning included, is not in it: a real
 robot renders nothing and its move_base plans in its own process). Goal: p99 under 20 ms. It
 also reports each tick's CPU time in the loop's thread (``time.thread_time``): the tick's own
@@ -29,21 +29,23 @@ worker) meanwhile — the figure to compare code changes by when the machine is 
 ticks are also split by what the observation carried (an RGB-D frame or not, read by a thin proxy
 around the robot's ``observe``; with the camera at the tick rate, as in the shipped missions,
 every tick has one) and by whether the tick did face work (inline: a face was embedded; with the
-worker: a head crop was submitted), and each tick's time is broken into stages by timing a few
-methods in this process only (laser perception, leg detection, camera perception, person
-detection, Algorithm 2 identification, face detection and embedding with dlib when inline, the
-worker's submit and poll, tracking, belief update, occupancy grid update, behavior tree,
-Algorithm 1, prediction, gaze, calls into the robot, Python's garbage collector): per stage how
-many ticks ran it, its median and p99 when it ran, and its mean share of the slowest 1 % of
-ticks. The ten slowest ticks are listed with their CPU time, the people in the frame, the
-clothing histograms measured and what they did. With the worker it also prints its
-jobs (submitted, completed, refused because two were out, results folded in or discarded because
-the track was gone, searches backed off on the back of a head) and the child's wall and CPU time
-per job, and the simulator's step time and how often the loop overran its period.
+worker: a head crop was submitted), and each tick's time is broken into the tick's stages —
+timed by calling them one after the other, as ``Follower.tick`` does (:func:`staged_tick`) — and
+the work inside them, timed by wrapping a few methods in this process only (laser perception,
+leg detection, camera perception, person detection, Algorithm 2 identification, face detection
+and embedding with dlib when inline, the worker's submit and poll, tracking, belief update,
+occupancy grid update, behavior tree, Algorithm 1, the gaze rule, calls into the robot, Python's
+garbage collector): per stage how many ticks ran it, its median and p99 when it ran, and its
+mean share of the slowest 1 % of ticks. The ten slowest ticks are listed with their CPU time,
+the people in the frame, the clothing histograms measured and what they did. With the worker
+it also prints its jobs (submitted, completed, refused because two were out, results folded in
+or discarded because the track was gone, searches backed off on the back of a head) and the
+child's wall and CPU time per job, and the simulator's step time and how often the loop overran
+its period.
 
 ``--profile`` then runs the same episode again (same seed) with :mod:`cProfile` enabled only
-inside ``Follower.tick`` and prints the ``--top`` (default 25) functions by cumulative time; the
-profiler slows every call down, so the percentiles above come from the un-profiled run.
+inside ``Follower.tick`` and prints the ``--top`` (default 25) functions by cumulative time;
+the profiler slows every call down, so the percentiles above come from the un-profiled run.
 
 Like ``bench_perception.py`` it pins itself to CPU 0 and sets one BLAS/OpenMP thread before
 numpy is imported, and prints the machine. It prints figures; it asserts nothing about time.
@@ -80,6 +82,8 @@ import numpy as np  # noqa: E402
 if TYPE_CHECKING:
     from pfctl.app.follower import EpisodeResult
     from pfctl.backends.pybullet.simulation import SimRobot
+    from pfctl.core.episode import TickRecord
+    from pfctl.core.follower import Follower
     from pfctl.core.perception.face_worker import FaceWorker
     from pfctl.core.robot import Observation
     from pfctl.mission import Mission
@@ -88,58 +92,62 @@ ROOT = Path(__file__).resolve().parents[1]
 CROWD = ROOT / "missions" / "house_crowd.yaml"
 GOAL_MS = 20.0
 
-#: The timed stages: (label, module, class or None for a module function, attribute).
-#: Indented labels run inside the stage above them; the unindented ones do not overlap.
-STAGES: tuple[tuple[str, str, str | None, str], ...] = (
-    ("laser perception (on_scan)", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
-    ("  leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
-    ("camera perception (on_frame)", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
-    ("  person detection (mask)", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
+#: The tick's stages (DESIGN.md "One tick of the follower"), timed by calling them in order as
+#: :meth:`pfctl.core.follower.Follower.tick` does (:func:`staged_tick`); they do not overlap.
+TICK_STAGES = ("observe", "perceive", "predict", "decide", "act", "log")
+
+#: Work inside the stages, timed by wrapping the methods that do it: (label, module, class or
+#: None for a module function, attribute). The indentation says which stage (or inner work) a
+#: label runs in.
+INNER: tuple[tuple[str, str, str | None, str], ...] = (
+    ("  laser perception (on_scan)", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
+    ("    leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
+    ("  camera perception (on_frame)", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
+    ("    person detection (mask)", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
     (
-        "  identification (Alg. 2)",
+        "    identification (Alg. 2)",
         "pfctl.core.perception.identity.identifier",
         "TargetIdentifier",
         "observe_frame",
     ),
-    ("    faces inline: dlib detect+embed", "pfctl.core.perception.faces", "FaceEncoder", "detect"),
-    ("    face worker: submit crop", "pfctl.core.perception.face_worker", "FaceWorker", "submit"),
-    ("    face worker: poll", "pfctl.core.perception.face_worker", "FaceWorker", "poll"),
     (
-        "    face worker: wait (deterministic)",
+        "      faces inline: dlib detect+embed",
+        "pfctl.core.perception.faces",
+        "FaceEncoder",
+        "detect",
+    ),
+    ("      face worker: submit crop", "pfctl.core.perception.face_worker", "FaceWorker", "submit"),
+    ("      face worker: poll", "pfctl.core.perception.face_worker", "FaceWorker", "poll"),
+    (
+        "      face worker: wait (deterministic)",
         "pfctl.core.perception.face_worker",
         "FaceWorker",
         "wait",
     ),
-    ("  belief update (Eq. 4)", "pfctl.core.perception.belief", "HumanBelief", "update"),
+    ("    belief update (Eq. 4)", "pfctl.core.perception.belief", "HumanBelief", "update"),
     (
-        "tracking (in on_scan/on_frame)",
+        "    tracking (in on_scan/on_frame)",
         "pfctl.core.perception.tracking",
         "MultiPersonTracker",
         "update",
     ),
-    ("occupancy grid (Eq. 1)", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
-    ("behavior tree (tick_once)", "py_trees.behaviour", "Behaviour", "tick_once"),
-    ("  Algorithm 1 (next_waypoint)", "pfctl.core.behavior.skills", "Skills", "next_waypoint"),
-    ("  grid planner (plan)", "pfctl.core.mapping.planning", "GridPlanner", "plan"),
-    ("  robot calls (sim navigate, …)", "", None, ""),
-    ("prediction (SVR, on loss)", "pfctl.core.follower", "Follower", "_predict"),
-    ("gaze", "pfctl.core.follower", "Follower", "_gaze"),
+    ("  occupancy grid (Eq. 1)", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
+    ("  behavior tree (tick_once)", "py_trees.behaviour", "Behaviour", "tick_once"),
+    (
+        "    Algorithm 1 (next_waypoint)",
+        "pfctl.core.behavior.world",
+        "WorldModel",
+        "next_waypoint",
+    ),
+    ("    grid planner (plan)", "pfctl.core.mapping.planning", "GridPlanner", "plan"),
+    ("  gaze rule (no leaf pointed the head)", "pfctl.core.follower", "Follower", "gaze_intent"),
+    ("  robot calls (navigate, command, …)", "", None, ""),
 )
-#: The robot's navigate/command/nav_status/cancel, called from the leaves (the simulator plans
-#: the path in its next step, as a real robot's move_base plans on its own).
-ROBOT_STAGE = "  robot calls (sim navigate, …)"
-OBSERVE_STAGE = "observe (sim)"
+#: The robot's calls from observe (its navigation status) and act (the intents sent); the
+#: simulator plans a path in its next step, as a real robot's move_base plans on its own.
+ROBOT_STAGE = "  robot calls (navigate, command, …)"
 GC_STAGE = "garbage collector (within the above)"
-#: The stages that do not overlap; the tick minus their sum is "other".
-TOP_LEVEL = (
-    OBSERVE_STAGE,
-    "laser perception (on_scan)",
-    "camera perception (on_frame)",
-    "occupancy grid (Eq. 1)",
-    "behavior tree (tick_once)",
-    "prediction (SVR, on loss)",
-    "gaze",
-)
+OTHER_STAGE = "other (between the stages)"
 
 
 class TickClock:
@@ -207,9 +215,30 @@ def _timed(clock: TickClock, stage: str, fn: Callable[..., Any]) -> Callable[...
     return wrapper
 
 
+def staged_tick(follower: Follower, clock: TickClock) -> TickRecord:
+    """One tick of ``follower``, its stages called in order (as ``Follower.tick`` calls them),
+    each one's wall time added to ``clock``."""
+
+    def stage(name: str, fn: Callable[..., Any], *args: Any) -> Any:
+        t0 = time.perf_counter()
+        try:
+            return fn(*args)
+        finally:
+            clock.add(name, time.perf_counter() - t0)
+
+    obs = stage("observe", follower.observe)
+    target = stage("perceive", follower.perceive, obs)
+    stage("predict", follower.predict, obs.stamp, target)
+    stage("decide", follower.decide, obs, target)
+    stage("act", follower.act, obs)
+    record: TickRecord = stage("log", follower.log_tick, obs, target)
+    return record
+
+
 @contextmanager
 def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> Iterator[None]:
-    """Wrap ``Follower.tick`` (and with ``clock`` the :data:`STAGES`) in this process; undo after.
+    """Run ``Follower.tick`` with ``clock`` as :func:`staged_tick` (each stage timed), the
+    :data:`INNER` work timed by wrappers, and ``profiler`` enabled; undo after.
 
     Nothing on disk changes: the wrappers replace class attributes of the imported modules."""
     from pfctl.core.follower import Follower
@@ -234,7 +263,7 @@ def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> 
         if profiler is not None:
             profiler.enable()
         try:
-            return tick(self)
+            return staged_tick(self, clock) if clock is not None else tick(self)
         finally:
             if profiler is not None:
                 profiler.disable()
@@ -249,7 +278,7 @@ def instrumented(clock: TickClock | None, profiler: cProfile.Profile | None) -> 
 
     patch(Follower, "tick", timed_tick)
     if clock is not None:
-        for label, module, cls, attr in STAGES:
+        for label, module, cls, attr in INNER:
             if not module:
                 continue
             try:
@@ -345,17 +374,15 @@ class ProbedRobot:
     the calls the follower makes into the robot (they are the simulator's cost, not the
     follower's); everything else goes straight to the robot."""
 
-    _TIMED = ("command", "navigate", "nav_status", "cancel")
+    _TIMED = ("command", "navigate", "nav_status", "cancel", "point_head")
 
     def __init__(self, robot: SimRobot, clock: TickClock | None) -> None:
         self._robot = robot
         self._clock = clock
 
     def observe(self) -> Observation:
-        t0 = time.perf_counter()
         observation = self._robot.observe()
         if self._clock is not None:
-            self._clock.add(OBSERVE_STAGE, time.perf_counter() - t0)
             self._clock.frames.append(observation.rgbd is not None)
             self._clock.scans.append(observation.scan is not None)
         return observation
@@ -508,10 +535,10 @@ def report(
 
     stage_ms = {
         label: 1000.0 * np.array([t.get(label, np.nan) for t in clock.ticks])
-        for label in [OBSERVE_STAGE, *(s[0] for s in STAGES), GC_STAGE]
+        for label in [*TICK_STAGES, *(s[0] for s in INNER), GC_STAGE]
     }
-    top = np.sum([np.nan_to_num(stage_ms[k]) for k in TOP_LEVEL], axis=0)
-    stage_ms["other (log, blackboard, …)"] = ms - top
+    top = np.sum([np.nan_to_num(stage_ms[k]) for k in TICK_STAGES], axis=0)
+    stage_ms[OTHER_STAGE] = ms - top
     slow = ms >= np.percentile(ms, 99)
     rest = ms[~embedded]
     slow_rest = ~embedded & (ms >= np.percentile(rest, 99)) if len(rest) else slow & False

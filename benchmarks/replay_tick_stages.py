@@ -1,4 +1,4 @@
-"""CPU time of the follower's perception stages on a recorded crowd episode, replayed offline.
+"""CPU time of the follower's perceive stage on a recorded crowd episode, replayed offline.
 
 Run::
 
@@ -6,12 +6,14 @@ Run::
     .venv/bin/python benchmarks/replay_tick_stages.py /tmp/crowd.pkl            # replay, ~1 min
 
 ``--record`` runs the crowd mission (``missions/house_crowd.yaml``, seed 7, 60 s, unpaced, faces
-searched inline) and keeps every observation the follower perceived, the person detector and the
-belief it started with and the target profile. The replay feeds the same scans and frames, in
-order, to a fresh :class:`~pfctl.core.perception.pipeline.Perception` (the identifier without faces:
-the live run's face results depend on timing) and an occupancy grid, then asks the belief for the
-gaze's peaks, as the follower's tick does, ``--repeats`` times (default 5). Per stage and call
-it keeps the smallest CPU time (``time.thread_time``) over the repeats — the replay is
+searched inline) and keeps every observation the follower took (read through a thin proxy around
+the robot), the person detector and the target profile. The replay builds a fresh follower for
+the mission (its perception's identifier without faces: the live run's face results depend on
+timing) and calls its stages on the same observations, in order: ``Follower.perceive`` (legs,
+tracks, detections, identity, belief, occupancy grid) and the gaze rule
+(``Follower.gaze_intent``, which asks the belief for its peaks), ``--repeats`` times (default
+5); the work inside them is timed by wrapping the methods that do it. Per stage and call it
+keeps the smallest CPU time (``time.thread_time``) over the repeats — the replay is
 deterministic, so call i is the same work in every repeat and the minimum strips most of what a
 busy machine adds — and prints median / p90 / p99 / max of those minima. A fixed workload to
 compare code changes by; pinned to CPU 0 with one BLAS thread like the other benchmarks.
@@ -42,60 +44,82 @@ import numpy as np  # noqa: E402
 ROOT = Path(__file__).resolve().parents[1]
 CROWD = ROOT / "missions" / "house_crowd.yaml"
 
-#: (label, module, class, method) timed in the replay; indented labels run inside the one above.
+#: The follower's stages the replay calls, timed by calling them.
+PERCEIVE, GAZE = "perceive", "gaze rule"
+#: (label, module, class, method): the stages (no module) and the work inside them, timed by
+#: wrapping; indented labels run inside the one above.
 STAGES: tuple[tuple[str, str, str, str], ...] = (
-    ("on_scan", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
-    ("  leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
-    ("    features", "pfctl.core.perception.legs.detector", "", "describe_segments"),
-    ("    forest", "pfctl.core.perception.legs.model", "LegModel", "predict_proba"),
-    ("    evidence", "pfctl.core.perception.legs.evidence", "LegEvidence", "update"),
-    ("  tracking", "pfctl.core.perception.tracking", "MultiPersonTracker", "update"),
-    ("on_frame", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
-    ("  person detection", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
+    (PERCEIVE, "", "", ""),
+    ("  on_scan", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
+    ("    leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
+    ("      features", "pfctl.core.perception.legs.detector", "", "describe_segments"),
+    ("      forest", "pfctl.core.perception.legs.model", "LegModel", "predict_proba"),
+    ("      evidence", "pfctl.core.perception.legs.evidence", "LegEvidence", "update"),
+    ("    tracking", "pfctl.core.perception.tracking", "MultiPersonTracker", "update"),
+    ("  on_frame", "pfctl.core.perception.pipeline", "Perception", "on_frame"),
+    ("    person detection", "pfctl.core.perception.vision", "MaskPersonDetector", "detect"),
     (
-        "  identification",
+        "    identification",
         "pfctl.core.perception.identity.identifier",
         "TargetIdentifier",
         "observe_frame",
     ),
-    ("  belief update", "pfctl.core.perception.belief", "HumanBelief", "update"),
-    ("grid update", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
-    ("belief most_likely", "pfctl.core.perception.belief", "HumanBelief", "most_likely"),
+    ("    belief update", "pfctl.core.perception.belief", "HumanBelief", "update"),
+    ("  grid update", "pfctl.core.mapping.grid", "OccupancyGrid", "update_scan"),
+    (GAZE, "", "", ""),
+    ("  belief most_likely", "pfctl.core.perception.belief", "HumanBelief", "most_likely"),
 )
 
 
+class KeepingRobot:
+    """The simulated robot, every observation the follower takes kept in ``observations``."""
+
+    def __init__(self, robot: Any, observations: list[Any]) -> None:
+        self._robot = robot
+        self._observations = observations
+
+    def observe(self) -> Any:
+        observation = self._robot.observe()
+        self._observations.append(dataclasses.replace(observation))
+        return observation
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._robot, name)
+
+
+class NoRobot:
+    """The replay's robot: the stages replayed never command it (closing the follower stops
+    the base)."""
+
+    def command(self, *args: Any) -> None:
+        pass
+
+
 def record(path: Path, duration: float) -> None:
-    """Run the crowd episode and pickle what the follower perceived."""
+    """Run the crowd episode and pickle what the follower observed."""
     from rich.console import Console
 
     from pfctl.app.episodes import run_sim_episode, sim_robot, target_profile
-    from pfctl.core import follower as follower_mod
+    from pfctl.core.perception.vision import MaskPersonDetector
     from pfctl.mission import load_mission
 
     mission = load_mission(CROWD)
     profile = target_profile(mission, None, None, Console(stderr=True), str(CROWD))
     robot = sim_robot(mission, None, False, str(CROWD))
-    kept: dict[str, Any] = {"observations": [], "profile": profile}
-    original = follower_mod.Follower._perceive
-
-    def perceive(self: Any, obs: Any) -> None:
-        if not kept["observations"]:
-            p = self.perception
-            kept["detector"] = copy.deepcopy(p.detector)
-            kept["belief"] = copy.deepcopy(p.belief)
-            kept["grid"] = copy.deepcopy(self.grid)
-        kept["observations"].append(dataclasses.replace(obs))
-        original(self, obs)
-
-    follower_mod.Follower._perceive = perceive  # type: ignore[method-assign]
-    try:
-        with robot:
-            run_sim_episode(mission, robot, profile, duration, face_worker=False)
-    finally:
-        follower_mod.Follower._perceive = original  # type: ignore[method-assign]
+    observations: list[Any] = []
+    kept: dict[str, Any] = {"observations": observations, "profile": profile}
+    with robot:
+        # the detector run_sim_episode makes for this robot
+        kept["detector"] = MaskPersonDetector(
+            robot.person_instances(),
+            robot.people_bodies.parts(),
+            min_pixels=mission.perception.vision.min_pixels,
+        )
+        port: Any = KeepingRobot(robot, observations)
+        run_sim_episode(mission, port, profile, duration, face_worker=False)
     with open(path, "wb") as f:
         pickle.dump(kept, f, protocol=pickle.HIGHEST_PROTOCOL)
-    print(f"{path}: {len(kept['observations'])} observations")
+    print(f"{path}: {len(observations)} observations")
 
 
 @contextmanager
@@ -105,6 +129,8 @@ def timed(times: dict[str, list[float]]) -> Iterator[None]:
 
     undo: list[Callable[[], None]] = []
     for label, module, cls, name in STAGES:
+        if not module:
+            continue  # a stage the replay calls
         owner: Any = importlib.import_module(module)
         if cls:
             owner = getattr(owner, cls)
@@ -133,52 +159,47 @@ def timed(times: dict[str, list[float]]) -> Iterator[None]:
 
 def replay_once(kept: dict[str, Any]) -> tuple[dict[str, list[float]], list[float], Any]:
     """One replay: per-stage call times, per-observation total, and the outputs (for checks)."""
-    from pfctl.app.perception import build_perception
-    from pfctl.core.control import KNOWN_RADIUS
-    from pfctl.core.follower import PEAK_CANDIDATES
+    from pfctl.app.follower import build_follower, static_map
+    from pfctl.app.perception import build_perception, identity_params
+    from pfctl.core.mapping.grid import FREE
+    from pfctl.core.perception.identity.identifier import TargetIdentifier
     from pfctl.mission import load_mission
 
     mission = load_mission(CROWD)
-    perception = build_perception(mission, detector=copy.deepcopy(kept["detector"]))
-    from pfctl.app.perception import identity_params
-    from pfctl.core.perception.identity.identifier import TargetIdentifier
-
+    grid = static_map(mission)
+    perception = build_perception(
+        mission,
+        detector=copy.deepcopy(kept["detector"]),
+        belief_grid=(grid.geometry, grid.states() != FREE),
+    )
     params = dataclasses.replace(identity_params(mission), faces=False)
     perception.identifier = TargetIdentifier(kept["profile"], params)
-    perception.belief = copy.deepcopy(kept["belief"])
-    grid = copy.deepcopy(kept["grid"])
+    follower = build_follower(mission, NoRobot(), perception)  # type: ignore[arg-type]
     times: dict[str, list[float]] = {s[0]: [] for s in STAGES}
     totals: list[float] = []
     outputs: list[Any] = []
     with timed(times):
         for obs in kept["observations"]:
             t0 = time.thread_time()
-            scan = obs.scan
-            if scan is not None:
-                legs = perception.on_scan(scan)
-            if obs.rgbd is not None:
-                perception.on_frame(obs.rgbd)
-            if scan is not None:
-                grid.update_scan(
-                    (scan.pose.x, scan.pose.y, scan.pose.theta),
-                    scan.ranges,
-                    scan.angle_min,
-                    scan.angle_increment,
-                    scan.range_max,
-                    scan.range_min,
-                )
-            peaks = perception.belief.most_likely(PEAK_CANDIDATES, min_separation=KNOWN_RADIUS)
-            totals.append(time.thread_time() - t0)
+            target = follower.perceive(obs)
+            t1 = time.thread_time()
+            head = follower.gaze_intent(obs.pose, target)
+            t2 = time.thread_time()
+            times[PERCEIVE].append(t1 - t0)
+            times[GAZE].append(t2 - t1)
+            totals.append(t2 - t0)
             outputs.append(
                 (
-                    legs,
+                    perception.last_legs,
                     [(t.id, t.x, t.y) for t in perception.tracks()],
-                    perception.identifier.target_track(),
-                    peaks,
+                    target,
+                    head,
                 )
             )
-    outputs.append(grid.logodds.copy())
+    outputs.append(follower.grid.logodds.copy())
+    assert perception.belief is not None
     outputs.append(perception.belief.p.copy())
+    follower.close()
     return times, totals, outputs
 
 
@@ -227,7 +248,7 @@ def main() -> int:
         f"replay of {args.pickle}: {len(kept['observations'])} observations, min of "
         f"{args.repeats} repeats per call (CPU time)"
     )
-    print(f"  {'perception+grid+peaks':24s} {_pcts(best_total)}")
+    print(f"  {'perceive + gaze rule':24s} {_pcts(best_total)}")
     for label, *_ in STAGES:
         print(f"  {label:24s} {_pcts(best[label])}")
     if args.save_outputs is not None:

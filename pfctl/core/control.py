@@ -3,9 +3,10 @@
 The paper's robot keeps the target in view with its head and drives after it with its base:
 
 * **Gaze control** points the head at the target, else at the highest human belief, else at leg
-  candidates (:func:`choose_gaze`), through the pan/tilt angles that aim the camera at a 3-D map
-  point (:func:`gaze_angles`) and a PD joint controller that respects the joint limits and the
-  head's top speed (:class:`GazeController`). :func:`sweep_pan` is the look-around profile.
+  candidates (:func:`gaze_rule`: the one rule for where the head looks when no behaviour points
+  it), through the pan/tilt angles that aim the camera at a 3-D map point (:func:`gaze_angles`)
+  and a PD joint controller that respects the joint limits and the head's top speed
+  (:class:`GazeController`). :func:`sweep_pan` is the look-around profile.
 * **Base control** (:class:`BaseController`) TURNs toward the target and GOes STRAIGHT when the
   line of sight on the occupancy grid is free, otherwise sends a MOVE_BASE goal toward it; it keeps
   the following distance, never drives into a person, and stops when the sensors go stale.
@@ -26,18 +27,22 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from pfctl.core.mapping.grid import GridGeometry
+from pfctl.core.mapping.paths import line_of_sight
 from pfctl.core.params import param
 from pfctl.core.robot import STOP, HeadState, HeadTarget, Pose2D, Twist2D, wrap_angle
 
 __all__ = [
     "KNOWN_RADIUS",
     "MODES",
+    "PEAK_CANDIDATES",
     "BaseCommand",
     "BaseController",
     "ControlParams",
     "GazeController",
     "choose_gaze",
     "gaze_angles",
+    "gaze_rule",
+    "peaks_in_sight",
     "sweep_pan",
     "unknown_peak",
 ]
@@ -47,6 +52,9 @@ _TWO_PI = 2.0 * math.pi
 #: A belief peak or leg candidate this close (m) to a person identified as not the target is
 #: that person: the gaze does not spend itself on them.
 KNOWN_RADIUS = 1.0
+
+#: Belief peaks considered for the gaze (the best one in sight and away from known people wins).
+PEAK_CANDIDATES = 8
 
 #: The base command modes, in the order :meth:`BaseController.follow` considers them.
 MODES = ("stop", "hold", "turn", "go_straight", "move_base")
@@ -337,6 +345,54 @@ def unknown_peak(
         if not len(known) or np.linalg.norm(known - (x, y), axis=1).min() > known_radius:
             return x, y, p
     return None
+
+
+def peaks_in_sight(
+    peaks: Sequence[tuple[float, float, float]],
+    robot_xy: tuple[float, float],
+    max_range: float,
+    blocked: NDArray[np.bool_] | None,
+    geometry: GridGeometry | None,
+) -> list[tuple[float, float, float]]:
+    """The belief peaks ``(x, y, p)`` the camera could see from ``robot_xy``: within
+    ``max_range`` and with a clear line of sight over ``blocked`` (the static map; None: every
+    peak). A peak behind walls — a person seen there long ago — cannot be checked by turning
+    the head, so it does not draw the gaze."""
+    if not peaks or blocked is None or geometry is None:
+        return list(peaks)
+    here = np.array([robot_xy[0], robot_xy[1]])
+    xy = np.array([(x, y) for x, y, _ in peaks])
+    near = np.linalg.norm(xy - here, axis=1) <= max_range
+    clear = line_of_sight(blocked, geometry, here, xy)
+    return [p for p, ok in zip(peaks, near & clear, strict=True) if ok]
+
+
+def gaze_rule(
+    robot_xy: tuple[float, float],
+    target_xy: tuple[float, float] | None,
+    peaks: Sequence[tuple[float, float, float]],
+    legs_xy: Sequence[tuple[float, float]],
+    *,
+    known_xy: Sequence[tuple[float, float]] = (),
+    ahead: tuple[float, float] | None = None,
+    belief_threshold: float = 0.3,
+    max_range: float = math.inf,
+    blocked: NDArray[np.bool_] | None = None,
+    geometry: GridGeometry | None = None,
+) -> tuple[tuple[float, float] | None, str]:
+    """Where the head looks when no behaviour points it, and why: the paper's gaze priority
+    (§II-E), the one rule of the follower's gaze.
+
+    The target if it is tracked; else the most likely human belief peak of ``peaks`` (``(x, y,
+    p)`` by decreasing p, e.g. :meth:`~pfctl.core.perception.belief.HumanBelief.most_likely`)
+    at least ``belief_threshold`` likely, in sight (:func:`peaks_in_sight`) and away from the
+    people of ``known_xy`` (identified as not the target: :func:`unknown_peak`); else the
+    nearest leg candidate not of such a person; else ``ahead`` (the navigation goal being
+    driven to); else nothing (:func:`choose_gaze`)."""
+    likely = [p for p in peaks if p[2] >= belief_threshold]
+    visible = peaks_in_sight(likely, robot_xy, max_range, blocked, geometry)
+    peak = unknown_peak(visible, known_xy)
+    return choose_gaze(target_xy, peak, legs_xy, robot_xy, known_xy=known_xy, ahead=ahead)
 
 
 def sweep_pan(elapsed: float, seconds: float, amplitude: float) -> float:

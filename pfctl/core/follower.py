@@ -1,22 +1,27 @@
 """The follower: one tick of the paper's architecture (Fig. 1), on any Robot port.
 
-:meth:`Follower.tick` runs, in order:
+:meth:`Follower.tick` runs these stages in order; each is a method that can be called (and
+timed) on its own:
 
-1. **observe** — the newest laser scan, RGB-D frame, pose and head angles (Robot port);
-2. **perceive** — legs + vision → tracking → identification (Algorithm 2) and the human belief
-   (Eq. 4): :class:`~pfctl.core.perception.pipeline.Perception`;
-3. **map** — the scan is fused into the robot's occupancy grid (Eq. 1), which starts unknown, so
-   what the robot has not seen yet shows as frontiers for Algorithm 1;
-4. **target state** — the identified track (if the tracker still has it), the last detection and
-   the detected path; when the target stops being detected, the prediction of §II-E is made from
-   the path of the last ``prediction.history_s`` seconds (the mission's model, the paper's
-   weighted SVR), clipped to the map, and its end moved into free space;
-5. **blackboard** — the keys of :mod:`pfctl.core.behavior.blackboard`;
-6. **behavior tree** — one tick of the mission's tree; its actions drive the base and the head
-   through :class:`~pfctl.core.behavior.skills.Skills`; a head no action claimed follows the
-   paper's gaze priority (target, belief, legs);
-7. **log** — a :class:`~pfctl.core.episode.TickRecord`: awareness (visible / tracked / lost /
-   predicted / searching), the active action, the base mode, the gaze.
+1. :meth:`~Follower.observe` — the newest laser scan, RGB-D frame, pose and head angles, and the
+   status of the navigation goal (Robot port);
+2. :meth:`~Follower.perceive` — legs + vision → tracking → identification (Algorithm 2) and the
+   human belief (Eq. 4): :class:`~pfctl.core.perception.pipeline.Perception`; the scan is fused
+   into the robot's occupancy grid (Eq. 1), which starts unknown, so what the robot has not seen
+   yet shows as frontiers for Algorithm 1. It gives the target's state: the identified track, if
+   the tracker still has it;
+3. :meth:`~Follower.predict` — the target's detected path is kept; when the target stops being
+   detected, the prediction of §II-E is made from the path of the last ``prediction.history_s``
+   seconds (the mission's model, the paper's weighted SVR), clipped to the map, and its end moved
+   into free space;
+4. :meth:`~Follower.decide` — the blackboard keys of :mod:`pfctl.core.behavior.blackboard` are
+   written and the mission's tree is ticked once: its leaves write intents for the base and the
+   head (:class:`~pfctl.core.behavior.intents.Intents`), never commands; a head no leaf pointed
+   follows the gaze rule (:func:`~pfctl.core.control.gaze_rule`: target, belief, legs);
+5. :meth:`~Follower.act` — the one place that sends the tick's intents to the robot (the head's
+   PD controller turns the head intents into a joint command);
+6. :meth:`~Follower.log_tick` — a :class:`~pfctl.core.episode.TickRecord`: awareness (visible /
+   tracked / lost / predicted / searching), the active action, the base mode, the gaze.
 
 The follower never reads ground truth. :meth:`close` stops the base.
 """
@@ -40,17 +45,34 @@ from pfctl.core.behavior.blackboard import (
     clear_namespace,
     new_namespace,
 )
+from pfctl.core.behavior.intents import (
+    CancelGoal,
+    HeadAngles,
+    HeadIntent,
+    Intents,
+    LookAt,
+    Navigate,
+    Navigation,
+    Stop,
+    Velocity,
+)
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS, leaf_factory
-from pfctl.core.behavior.skills import SearchParams, Skills
+from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.behavior.tree import build_tree
-from pfctl.core.control import KNOWN_RADIUS, ControlParams, unknown_peak
+from pfctl.core.behavior.world import WorldModel
+from pfctl.core.control import (
+    KNOWN_RADIUS,
+    PEAK_CANDIDATES,
+    ControlParams,
+    GazeController,
+    gaze_angles,
+    gaze_rule,
+)
 from pfctl.core.episode import EpisodeLog, PredictionRecord, TickRecord, WaypointRecord
 from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
-from pfctl.core.mapping.paths import line_of_sight
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.regions import RegionMap, WaypointDecision
 from pfctl.core.params import param
-from pfctl.core.perception.identity.identifier import Decision
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.clipping import clip_prediction
 from pfctl.core.prediction.models import (
@@ -60,10 +82,7 @@ from pfctl.core.prediction.models import (
     PredictionError,
     make_model,
 )
-from pfctl.core.robot import STOP, Observation, Robot
-
-#: Belief peaks considered for the gaze (the best one away from known people wins).
-PEAK_CANDIDATES = 8
+from pfctl.core.robot import STOP, HeadTarget, Observation, Pose2D, Robot
 
 
 @dataclass(frozen=True)
@@ -129,13 +148,18 @@ class Follower:
         self.grid = OccupancyGrid(static_map.geometry, sensor_model=sensor_model)
         self.planner = GridPlanner(static_map, robot_radius)
         self.dt = 1.0 / params.tick_hz
-        self.skills = Skills(
-            robot, params.control, self.planner, self.grid, regions, params.search, self.dt
-        )
+        self.world = WorldModel(self.grid, self.planner, regions, params.search)
+        self.navigation = Navigation()
+        self.intents = Intents(params.control, self.world, self.navigation)
+        self.gaze = GazeController(params.control)
+        """The head's PD joint controller (act: one step per head intent)."""
         self.namespace = new_namespace()
         self._writer = py_trees.blackboard.Client(name="follower", namespace=self.namespace)
         for key in KEYS:
             self._writer.register_key(key, access=Access.WRITE)
+        self._writer.world = self.world
+        self._writer.intents = self.intents
+        self._writer.waypoint = None
         self._now = 0.0
         defaults = {"follow_target": {"distance": params.control.following_distance}}
         defaults.update(leaf_defaults or {})
@@ -153,32 +177,25 @@ class Follower:
     # -- the tick ---------------------------------------------------------------------------------
 
     def tick(self) -> TickRecord:
-        """One tick: observe, perceive, map, decide, act, log (module docstring)."""
-        obs = self.robot.observe()
-        now = obs.stamp
-        self._now = now
-        self._perceive(obs)
-        target = self._target_state(now)
-        visible = target is not None and now - target.last_detected <= self.params.visible_age
-        self._update_sightings(now, target, visible)
-        self._write_blackboard(now, obs, target)
-        people = [
-            t.position
-            for t in self.perception.tracks()
-            if target is None or t.id != target.track_id
-        ]
-        self.skills.begin_tick(now, obs.pose, obs.head, self._last_scan_stamp, people)
-        self.root.tick_once()
-        self.skills.end_tick()
-        self._gaze(target)
-        record = self._record(now, obs, target, visible)
-        self.log.ticks.append(record)
-        self.ticks += 1
-        return record
+        """One tick: observe, perceive, predict, decide, act, log (module docstring)."""
+        obs = self.observe()
+        target = self.perceive(obs)
+        self.predict(obs.stamp, target)
+        self.decide(obs, target)
+        self.act(obs)
+        return self.log_tick(obs, target)
 
-    def _perceive(self, obs: Observation) -> None:
+    def observe(self) -> Observation:
+        """What the robot senses now (Robot port), and the status of its navigation goal."""
+        obs = self.robot.observe()
+        self._now = obs.stamp
+        self.navigation.status = self.robot.nav_status()
+        return obs
+
+    def perceive(self, obs: Observation) -> TargetState | None:
         """Feed the scan (then log the tracks it leaves, as ``pfctl replay`` does after each
-        scan of a bag) and the frame to the perception; update the occupancy grid (Eq. 1)."""
+        scan of a bag) and the frame to the perception; update the occupancy grid (Eq. 1) and
+        the people of the world model. The target's state: its identified track, if any."""
         scan = obs.scan
         if scan is not None:
             self.perception.on_scan(scan)
@@ -195,15 +212,29 @@ class Follower:
                 scan.range_max,
                 scan.range_min,
             )
+        target = self._target_state()
+        people = [
+            t.position
+            for t in self.perception.tracks()
+            if target is None or t.id != target.track_id
+        ]
+        self.world.update(self._last_scan_stamp, people)
+        return target
 
-    def _target_state(self, now: float) -> TargetState | None:
+    def _target_state(self) -> TargetState | None:
         track = self.perception.target()
         if track is None:
             return None
         return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
 
-    def _update_sightings(self, now: float, target: TargetState | None, visible: bool) -> None:
-        """Keep the detected path; make a prediction when the target stops being detected."""
+    def _visible(self, now: float, target: TargetState | None) -> bool:
+        """The target was detected within ``visible_age`` seconds."""
+        return target is not None and now - target.last_detected <= self.params.visible_age
+
+    def predict(self, now: float, target: TargetState | None) -> None:
+        """Keep the target's detected path; predict where it went when it stops being detected
+        (§II-E)."""
+        visible = self._visible(now, target)
         if visible and target is not None:
             self._path.append((target.last_detected, target.x, target.y))
             while self._path and self._path[0][0] < now - self.params.keep_path_s:
@@ -213,10 +244,10 @@ class Follower:
             )
             self._prediction = None
         elif self._had_target and self._last_seen is not None:
-            self._prediction = self._predict(now, self._last_seen)
+            self._prediction = self._fit_prediction(now, self._last_seen)
         self._had_target = visible
 
-    def _predict(self, now: float, seen: Sighting) -> PredictionState | None:
+    def _fit_prediction(self, now: float, seen: Sighting) -> PredictionState | None:
         """§II-E: fit the mission's predictor to the last ``history_s`` of the detected path
         (the paper's weighted SVR), predict ``horizon_s`` ahead, clip to the map, and move the
         end into free space for the robot."""
@@ -235,7 +266,7 @@ class Follower:
         except PredictionError:
             return None
         clipped = clip_prediction(seen.xy, path, self.planner_grid, self.regions)
-        goal = self.skills.free_goal(clipped.end)
+        goal = self.planner.free_goal(clipped.end)
         if goal is None:
             return None
         state = PredictionState(now, seen.xy, clipped.xy, goal, clipped.region)
@@ -247,66 +278,91 @@ class Follower:
         """The static map the planner uses (walls and furniture)."""
         return self.planner.static
 
-    def _write_blackboard(self, now: float, obs: Observation, target: TargetState | None) -> None:
+    def decide(self, obs: Observation, target: TargetState | None) -> None:
+        """Write the blackboard and tick the tree once: its leaves write the tick's intents; a
+        tick in which no leaf drove the base stops it (:meth:`Intents.end`), and a head no leaf
+        pointed follows the gaze rule (:meth:`gaze_intent`)."""
         w = self._writer
-        w.t = now
+        w.t = obs.stamp
         w.pose = obs.pose
         w.target = target
         w.last_seen = self._last_seen
         w.prediction = self._prediction
-        w.skills = self.skills
+        self.intents.begin(obs.stamp, obs.pose)
+        self.root.tick_once()
+        self.intents.end()
+        if not self.intents.head:
+            self.intents.head.append(self.gaze_intent(obs.pose, target))
 
-    def _gaze(self, target: TargetState | None) -> None:
-        """The head when no leaf claimed it (§II-E gaze priority), not spent on people
-        Algorithm 2 has already identified as not the target."""
-        known = self._known_others(target)
-        belief = self.perception.belief
-        peak = None
-        if belief is not None:
-            peaks = belief.most_likely(PEAK_CANDIDATES, min_separation=KNOWN_RADIUS)
-            peaks = [p for p in peaks if p[2] >= self.params.belief_threshold]
-            peak = unknown_peak(self._in_sight(peaks), known)
-        legs = self.perception.last_legs
-        legs_xy = [(c.x, c.y) for c in legs.people] if legs is not None else []
-        target_xy = target.xy if target is not None else None
-        self.skills.default_gaze(target_xy, peak, legs_xy, known)
+    def gaze_intent(self, pose: Pose2D, target: TargetState | None) -> HeadIntent:
+        """Where the head looks when no leaf points it: the gaze rule
+        (:func:`~pfctl.core.control.gaze_rule`: the target, else the belief peak in sight, else
+        the legs, else the navigation goal) on what the perception knows, leaving out the
+        people Algorithm 2 has already identified as not the target."""
+        perception = self.perception
+        known = perception.not_target(target.track_id if target is not None else None)
+        belief = perception.belief
+        peaks = (
+            belief.most_likely(PEAK_CANDIDATES, min_separation=KNOWN_RADIUS)
+            if belief is not None
+            else []
+        )
+        legs = perception.last_legs
+        point, source = gaze_rule(
+            (pose.x, pose.y),
+            target.xy if target is not None else None,
+            peaks,
+            [(c.x, c.y) for c in legs.people] if legs is not None else [],
+            known_xy=known,
+            ahead=self.navigation.goal,
+            belief_threshold=self.params.belief_threshold,
+            max_range=perception.camera_range[1],
+            blocked=belief.blocked if belief is not None else None,
+            geometry=belief.geometry if belief is not None else None,
+        )
+        if point is None:
+            return HeadAngles(0.0, 0.0, source)
+        return LookAt(point, source)
 
-    def _in_sight(
-        self, peaks: list[tuple[float, float, float]]
-    ) -> list[tuple[float, float, float]]:
-        """The belief peaks the camera could see from here: within its range and with a clear
-        line of sight over the static map (a peak behind walls — a person seen there long ago —
-        cannot be checked by turning the head, so it does not draw the gaze)."""
-        belief = self.perception.belief
-        if not peaks or belief is None or belief.blocked is None:
-            return peaks
-        here = np.array([self.skills.pose.x, self.skills.pose.y])
-        xy = np.array([(x, y) for x, y, _ in peaks])
-        near = np.linalg.norm(xy - here, axis=1) <= self.perception.camera_range[1]
-        clear = line_of_sight(belief.blocked, belief.geometry, here, xy)
-        return [p for p, ok in zip(peaks, near & clear, strict=True) if ok]
+    def act(self, obs: Observation) -> None:
+        """Send the tick's intents to the robot: the one place the follower commands it. The
+        base intent becomes its Robot-port call; each head intent is one step of the head's PD
+        controller toward it (:class:`~pfctl.core.control.GazeController`) and the last
+        step's joint command is sent."""
+        self._send_base()
+        command: HeadTarget | None = None
+        for intent in self.intents.head:
+            command = self.gaze.update(obs.head, self._head_goal(obs.pose, intent), self.dt)
+        if command is not None:
+            self.robot.point_head(command)
 
-    def _known_others(self, target: TargetState | None) -> list[tuple[float, float]]:
-        """Where the tracks identified as not the target are."""
-        identifier = self.perception.identifier
-        if identifier is None:
-            return []
-        others = {
-            tid
-            for tid, ident in identifier.identities().items()
-            if ident.decision is Decision.NOT_TARGET
-        }
-        return [
-            t.position
-            for t in self.perception.tracks()
-            if t.id in others and (target is None or t.id != target.track_id)
-        ]
+    def _send_base(self) -> None:
+        base = self.intents.base
+        if isinstance(base, Velocity):
+            self.robot.command(base.twist)
+        elif isinstance(base, Stop):
+            if base.cancel_goal:
+                self.robot.cancel()
+            self.robot.command(STOP)
+        elif isinstance(base, Navigate):
+            self.robot.navigate(base.goal)
+        elif isinstance(base, CancelGoal):
+            self.robot.cancel()
 
-    def _record(
-        self, now: float, obs: Observation, target: TargetState | None, visible: bool
-    ) -> TickRecord:
-        action = self.skills.action
-        if visible:
+    def _head_goal(self, pose: Pose2D, intent: HeadIntent) -> HeadTarget:
+        """The head angles ``intent`` asks for from ``pose``."""
+        if isinstance(intent, LookAt):
+            control = self.params.control
+            point = (intent.xy[0], intent.xy[1], control.look_height)
+            return gaze_angles(pose, point, control)
+        return HeadTarget(intent.pan, intent.tilt)
+
+    def log_tick(self, obs: Observation, target: TargetState | None) -> TickRecord:
+        """The tick's record (appended to the log), and a way-point record for a new decision of
+        Algorithm 1."""
+        now = obs.stamp
+        action = self.intents.action
+        if self._visible(now, target):
             awareness = "visible"
         elif target is not None:
             awareness = "tracked"
@@ -316,32 +372,37 @@ class Follower:
             awareness = "searching"
         else:
             awareness = "lost"
-        decision = getattr(self.skills, "waypoint", None)
+        decision: WaypointDecision | None = self._writer.waypoint
         if decision is not None and decision is not self._last_waypoint:
             self._last_waypoint = decision
             self.log.waypoints.append(
                 WaypointRecord(now, decision.waypoint, decision.reason, decision.heading_region)
             )
-        return TickRecord(
+        record = TickRecord(
             t=now,
             pose=obs.pose,
             awareness=awareness,
             action=action,
             target_id=target.track_id if target is not None else None,
             target_xy=target.xy if target is not None else None,
-            goal=self.skills.nav_goal,
-            base_mode=self.skills.base_mode,
-            gaze=self.skills.gaze_source,
+            goal=self.navigation.goal,
+            base_mode=self.intents.base_mode,
+            gaze=self.intents.gaze_source,
         )
+        self.log.ticks.append(record)
+        self.ticks += 1
+        return record
 
     def close(self) -> None:
-        """Stop the base, drop the blackboard keys and release the perception (its face
-        worker); safe to call twice."""
+        """Stop the running actions (a goal they drove to is cancelled) and the base, drop the
+        blackboard keys and release the perception (its face worker); safe to call twice."""
         if self._closed:
             return
         self._closed = True
         try:
+            self.intents.base = None
             self.root.stop(py_trees.common.Status.INVALID)
+            self._send_base()
         finally:
             self.robot.command(STOP)
             clear_namespace(self.namespace)

@@ -14,6 +14,7 @@ from pfctl.core.control import (
     GazeController,
     choose_gaze,
     gaze_angles,
+    gaze_rule,
     sweep_pan,
     unknown_peak,
 )
@@ -258,6 +259,29 @@ def test_unknown_peak_is_the_best_peak_away_from_known_people() -> None:
     assert unknown_peak(peaks, [(1.3, 1.2), (4.5, 0.5)]) == (6.0, 0.0, 0.5)
     assert unknown_peak(peaks, [(1.05, 1.0)], known_radius=0.01) == (1.0, 1.0, 0.99)
     assert unknown_peak([], [(0.0, 0.0)]) is None
+
+
+def test_gaze_rule_looks_at_a_likely_peak_in_sight_away_from_known_people() -> None:
+    robot = (0.0, 0.0)
+    geometry = GridGeometry(0.1, 100, 100, (-5.0, -5.0))
+    blocked = np.zeros(geometry.shape, dtype=bool)
+    blocked[50:60, 70] = True  # a wall at x = 2.05 between y = 0 and 1
+    peaks = [(3.0, 0.5, 0.9), (0.0, 3.0, 0.6), (-2.0, 0.0, 0.5), (1.0, -1.0, 0.2)]
+    legs = [(1.0, -1.0)]
+    sight = {"max_range": 4.0, "blocked": blocked, "geometry": geometry}
+    # the best peak is behind the wall: the next one in sight
+    assert gaze_rule(robot, None, peaks, legs, **sight) == ((0.0, 3.0), "belief")
+    # … unless that person was identified as not the target
+    known = [(0.2, 3.1)]
+    assert gaze_rule(robot, None, peaks, legs, known_xy=known, **sight) == ((-2.0, 0.0), "belief")
+    # too far for the camera, or too unlikely: the legs
+    near = {**sight, "max_range": 1.5}
+    assert gaze_rule(robot, None, peaks[1:], legs, **near) == ((1.0, -1.0), "legs")
+    assert gaze_rule(robot, None, peaks, legs, belief_threshold=0.95) == ((1.0, -1.0), "legs")
+    # the target first; nothing at all: the goal ahead, else nowhere
+    assert gaze_rule(robot, (4.0, 4.0), peaks, legs) == ((4.0, 4.0), "target")
+    assert gaze_rule(robot, None, [], [], ahead=(2.0, 2.0)) == ((2.0, 2.0), "goal")
+    assert gaze_rule(robot, None, [], []) == (None, "none")
 
 
 def test_sweep_pan_profile() -> None:

@@ -1,7 +1,9 @@
 """The behavior tree's shared state: declared py_trees blackboard keys (§II-A).
 
-The follower (:mod:`pfctl.core.follower`) writes these keys once per tick, before the tree is
-ticked; leaves (:mod:`pfctl.core.behavior.leaves`) declare which of them they read or write. Each
+The follower (:mod:`pfctl.core.follower`) writes the state keys once per tick, before the tree
+is ticked; leaves (:mod:`pfctl.core.behavior.leaves`) declare which of them they read or write:
+they read the state and the world model and write their intents (``intents``) — never a command
+to the robot — and way-point search writes its latest decision (``waypoint``). Each
 follower has its own namespace (:func:`new_namespace`), so two followers in one process (tests,
 campaigns) never share state; :func:`clear_namespace` drops one when its follower closes.
 """
@@ -23,7 +25,10 @@ KEYS: dict[str, str] = {
     "target": "TargetState | None: the identified target's track, if the tracker still has it",
     "last_seen": "Sighting | None: where and when the target was last detected, with its path",
     "prediction": "PredictionState | None: where the lost target is predicted to have gone",
-    "skills": "Skills: how leaves drive the base and the head, navigate and search",
+    "world": "WorldModel: the robot's occupancy grid, the static map's planner, the regions and "
+    "the people it tracks, for the leaves' control laws and Algorithm 1",
+    "intents": "Intents: what the leaves want the base and the head to do this tick",
+    "waypoint": "WaypointDecision | None: Algorithm 1's latest way-point (waypoint_search)",
 }
 
 _counter = itertools.count(1)

@@ -1,15 +1,17 @@
 """The condition and action leaves of the behavior tree (§II-A, Fig. 2), on py_trees.
 
-Every leaf reads the follower's state from the blackboard keys of
-:mod:`pfctl.core.behavior.blackboard` (declared per leaf) and acts through the ``skills`` key
-(:class:`~pfctl.core.behavior.skills.Skills`). The statuses are honest: a condition is SUCCESS
+Every leaf reads the follower's state and world model from the blackboard keys of
+:mod:`pfctl.core.behavior.blackboard` (declared per leaf) and writes what the robot should do into
+the ``intents`` key (:class:`~pfctl.core.behavior.intents.Intents`); no leaf commands the robot:
+the follower's act stage sends the tick's intents. The statuses are honest: a condition is SUCCESS
 or FAILURE at once; an action is RUNNING while it works (a navigation in progress is running),
 SUCCESS when it has done its job, FAILURE when it cannot. An action that drives the base gives it
 up in ``terminate`` — also when a higher-priority branch preempts it (status INVALID).
 
-The names and parameters are those of :data:`pfctl.core.behavior.registry.LEAF_SPECS`;
-:func:`leaf_factory` makes the ``factory`` that :func:`pfctl.core.behavior.tree.build_tree`
-calls for each leaf of a mission's layout.
+Each leaf class declares its name, kind, summary and parameters (its ``spec``, Nav2's
+``providedPorts()``); :data:`LEAF_CLASSES` is every leaf by name, and :func:`leaf_factory` makes
+the ``factory`` that :func:`pfctl.core.behavior.tree.build_tree` calls for each leaf of a
+mission's layout.
 """
 
 from __future__ import annotations
@@ -24,16 +26,29 @@ import py_trees
 from py_trees.common import Access, Status
 
 from pfctl.core.behavior.blackboard import PredictionState, Sighting, TargetState
-from pfctl.core.behavior.registry import LEAF_SPECS
-from pfctl.core.behavior.skills import Skills
+from pfctl.core.behavior.intents import Intents
+from pfctl.core.behavior.spec import LeafSpec, param
+from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.regions import WaypointDecision
 
 
 class Leaf(py_trees.behaviour.Behaviour):
-    """A leaf with its resolved parameters and a blackboard client in the follower's namespace."""
+    """A leaf with its resolved parameters and a blackboard client in the follower's namespace.
 
-    reads: ClassVar[tuple[str, ...]] = ("t", "pose", "target", "last_seen", "prediction", "skills")
+    Each concrete leaf declares its ``spec``: its name in a mission's tree, its kind, what it
+    does and its parameters (the registry and the mission's JSON Schema come from these)."""
+
+    spec: ClassVar[LeafSpec]
+    reads: ClassVar[tuple[str, ...]] = (
+        "t",
+        "pose",
+        "target",
+        "last_seen",
+        "prediction",
+        "world",
+        "intents",
+    )
     writes: ClassVar[tuple[str, ...]] = ()
 
     def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
@@ -67,8 +82,13 @@ class Leaf(py_trees.behaviour.Behaviour):
         return value
 
     @property
-    def skills(self) -> Skills:
-        value: Skills = self.bb.skills
+    def world(self) -> WorldModel:
+        value: WorldModel = self.bb.world
+        return value
+
+    @property
+    def intents(self) -> Intents:
+        value: Intents = self.bb.intents
         return value
 
     def visible(self, max_age: float = 0.5) -> bool:
@@ -82,6 +102,13 @@ class Leaf(py_trees.behaviour.Behaviour):
 class TargetVisible(Leaf):
     """SUCCESS when the identified target's track was detected within ``max_age`` s."""
 
+    spec = LeafSpec(
+        "target_visible",
+        "condition",
+        "The identified target's track was detected (laser legs or camera) within max_age s.",
+        (param("max_age", 0.5, "seconds since the target's last detection", minimum=0.0),),
+    )
+
     def update(self) -> Status:
         return Status.SUCCESS if self.visible(self.params["max_age"]) else Status.FAILURE
 
@@ -89,12 +116,33 @@ class TargetVisible(Leaf):
 class TargetTracked(Leaf):
     """SUCCESS while the tracker holds the identified target's track (detected or coasting)."""
 
+    spec = LeafSpec(
+        "target_tracked",
+        "condition",
+        "The tracker still holds the identified target's track (detected or coasting).",
+    )
+
     def update(self) -> Status:
         return Status.SUCCESS if self.target is not None else Status.FAILURE
 
 
 class TargetLostFor(Leaf):
     """SUCCESS when the target has not been detected for ``seconds`` (or was never seen)."""
+
+    spec = LeafSpec(
+        "target_lost_for",
+        "condition",
+        "The target has not been visible for at least `seconds` (or was never seen).",
+        (
+            param(
+                "seconds",
+                None,
+                "how long the target has been out of sight",
+                minimum=0.0,
+                required=True,
+            ),
+        ),
+    )
 
     def update(self) -> Status:
         target, seen = self.target, self.last_seen
@@ -105,6 +153,12 @@ class TargetLostFor(Leaf):
 class PredictionAvailable(Leaf):
     """SUCCESS when a prediction of the lost target exists and has not been used up."""
 
+    spec = LeafSpec(
+        "prediction_available",
+        "condition",
+        "A prediction of where the lost target went exists and has not been looked at yet.",
+    )
+
     def update(self) -> Status:
         p = self.prediction
         return Status.SUCCESS if p is not None and p.available else Status.FAILURE
@@ -113,6 +167,13 @@ class PredictionAvailable(Leaf):
 class NearTarget(Leaf):
     """SUCCESS when the robot is within ``distance`` of the target (else of where it was last
     seen)."""
+
+    spec = LeafSpec(
+        "near_target",
+        "condition",
+        "The robot is within `distance` metres of the target's estimated position.",
+        (param("distance", 1.0, "metres", minimum=0.0),),
+    )
 
     def update(self) -> Status:
         target, seen = self.target, self.last_seen
@@ -128,10 +189,10 @@ class NearTarget(Leaf):
 
 
 class Action(Leaf):
-    """An action: it names itself to the skills while it runs and gives up the base at the end."""
+    """An action: it names itself in the intents while it runs and gives up the base at the end."""
 
     def update(self) -> Status:
-        self.skills.claim(self.name)
+        self.intents.claim(self.name)
         return self.act()
 
     def act(self) -> Status:
@@ -139,29 +200,50 @@ class Action(Leaf):
 
     def terminate(self, new_status: Status) -> None:
         if new_status in (Status.INVALID, Status.FAILURE):
-            self.skills.release()
+            self.intents.release()
 
 
 class FollowTarget(Action):
     """Drive after the target (§II-E): TURN + GO_STRAIGHT, or MOVE_BASE when the line of sight
     is blocked; keeps ``distance``. RUNNING while there is a target, FAILURE without one."""
 
+    spec = LeafSpec(
+        "follow_target",
+        "action",
+        "Drive after the target (TURN + GO_STRAIGHT when the line of sight is free, else "
+        "MOVE_BASE), keeping the following distance; running while there is a target.",
+        (
+            param(
+                "distance",
+                None,
+                "following distance, m (default control.following_distance)",
+                minimum=0.3,
+            ),
+        ),
+    )
+
     def act(self) -> Status:
         target = self.target
         if target is None:
             return Status.FAILURE
-        self.skills.follow(target.xy, self.params["distance"])
+        self.intents.follow(target.xy, self.params["distance"])
         return Status.RUNNING
 
 
 class GazeAtTarget(Action):
     """Point the head at the target; RUNNING while there is one, FAILURE without."""
 
+    spec = LeafSpec(
+        "gaze_at_target",
+        "action",
+        "Point the head at the target; running while there is one, failure otherwise.",
+    )
+
     def act(self) -> Status:
         target = self.target
         if target is None:
             return Status.FAILURE
-        self.skills.look_at(target.xy, "target")
+        self.intents.look_at(target.xy, "target")
         return Status.RUNNING
 
     def terminate(self, new_status: Status) -> None:
@@ -173,13 +255,21 @@ class GoToPrediction(Action):
     the robot already arrived there), FAILURE without a prediction or a way there (the
     prediction is then used up)."""
 
+    spec = LeafSpec(
+        "go_to_prediction",
+        "action",
+        "Navigate to where the prediction says the target went; success on arrival, failure "
+        "when there is no prediction or no way there.",
+        (param("tolerance", 0.5, "arrival distance, m", minimum=0.05),),
+    )
+
     def act(self) -> Status:
         p = self.prediction
         if p is None or p.used:
             return Status.FAILURE
         if p.reached:
             return Status.SUCCESS
-        outcome = self.skills.go_to(p.goal, self.params["tolerance"])
+        outcome = self.intents.go_to(p.goal, self.params["tolerance"])
         if outcome == "arrived":
             p.reached = True
             return Status.SUCCESS
@@ -194,6 +284,18 @@ class LookAround(Action):
     SUCCESS as soon as the target is detected; FAILURE when the sweep ends without it — the
     prediction (if any) is then used up, so the tree moves on (Fig. 2: way-point search)."""
 
+    spec = LeafSpec(
+        "look_around",
+        "action",
+        "Sweep the head (and turn the base) to look for the target; success when the target "
+        "is seen, failure when the sweep ends without it (the prediction is used up).",
+        (
+            param("seconds", 8.0, "length of the sweep, s", minimum=0.5),
+            param("pan", 1.4, "head pan to either side, rad", minimum=0.0, maximum=3.0),
+            param("turn", True, "also turn the base once around", kind=bool),
+        ),
+    )
+
     def initialise(self) -> None:
         self._start = self.t
 
@@ -205,14 +307,14 @@ class LookAround(Action):
         if elapsed >= seconds:
             if self.prediction is not None:
                 self.prediction.used = True
-            self.skills.stop()
+            self.intents.stop()
             return Status.FAILURE
-        self.skills.set_pan(sweep_pan(elapsed, seconds, float(self.params["pan"])))
+        self.intents.set_pan(sweep_pan(elapsed, seconds, float(self.params["pan"])))
         if self.params["turn"]:
-            wz = min(2.0 * math.pi / seconds, self.skills.control.max_angular_speed)
-            self.skills.turn(wz)
+            wz = min(2.0 * math.pi / seconds, self.intents.control.max_angular_speed)
+            self.intents.turn(wz)
         else:
-            self.skills.stop()
+            self.intents.stop()
         return Status.RUNNING
 
 
@@ -225,6 +327,15 @@ class WaypointSearch(Action):
     frontier left has been visited, it turns in place to look and starts
     afresh. RUNNING until the target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing
     at all to search (no region to go to)."""
+
+    spec = LeafSpec(
+        "waypoint_search",
+        "action",
+        "Algorithm 1: go to the best frontier toward the heading region, look, repeat; "
+        "running until the target is found, failure when nothing is left to search.",
+        (param("tolerance", 0.4, "arrival distance at a way-point, m", minimum=0.05),),
+    )
+    writes = ("waypoint",)
 
     REPLAN_S: ClassVar[float] = 3.0
     #: A frontier goal this close to a visited way-point counts as visited, metres.
@@ -243,7 +354,8 @@ class WaypointSearch(Action):
     def _decide(self) -> WaypointDecision:
         seen = self.last_seen
         history = seen.history if seen is not None else np.empty((0, 3))
-        decision = self._unvisited(self.skills.next_waypoint(history))
+        pose = self.bb.pose
+        decision = self._unvisited(self.world.next_waypoint(history, (pose.x, pose.y)))
         self._decided_at = self.t
         current = self._decision
         keep = None
@@ -259,7 +371,7 @@ class WaypointSearch(Action):
         if keep is not None:
             decision = _with_waypoint(decision, keep)
         self._decision = decision
-        self.skills.waypoint = decision
+        self.bb.waypoint = decision
         return decision
 
     def _unvisited(self, decision: WaypointDecision) -> WaypointDecision:
@@ -314,7 +426,7 @@ class WaypointSearch(Action):
             decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        outcome = self.skills.go_to(decision.waypoint, self.params["tolerance"])
+        outcome = self.intents.go_to(decision.waypoint, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING
         self._visited.append(decision.waypoint)
@@ -323,8 +435,8 @@ class WaypointSearch(Action):
         decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        if self.skills.go_to(decision.waypoint, self.params["tolerance"]) != "running":
-            self.skills.turn(self.skills.control.max_angular_speed * 0.5)
+        if self.intents.go_to(decision.waypoint, self.params["tolerance"]) != "running":
+            self.intents.turn(self.intents.control.max_angular_speed * 0.5)
         return Status.RUNNING
 
 
@@ -341,6 +453,14 @@ class GoToLastSeen(Action):
     does not try again on every tick; a new sighting starts afresh. The "go to the last seen
     position" baseline (``missions/trees/last_seen.yaml``)."""
 
+    spec = LeafSpec(
+        "go_to_last_seen",
+        "action",
+        "Navigate to where the target was last seen; success on arrival (and from then on "
+        "for that sighting), failure when it was never seen or there is no way there.",
+        (param("tolerance", 0.5, "arrival distance, m", minimum=0.05),),
+    )
+
     def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
         super().__init__(name, namespace, params)
         self._outcome: tuple[float, Status] | None = None
@@ -352,7 +472,7 @@ class GoToLastSeen(Action):
             return Status.FAILURE
         if self._outcome is not None and self._outcome[0] == seen.t:
             return self._outcome[1]
-        outcome = self.skills.go_to(seen.xy, self.params["tolerance"])
+        outcome = self.intents.go_to(seen.xy, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING
         status = Status.SUCCESS if outcome == "arrived" else Status.FAILURE
@@ -363,26 +483,32 @@ class GoToLastSeen(Action):
 class Stop(Action):
     """Stop the base; SUCCESS."""
 
+    spec = LeafSpec("stop", "action", "Stop the base; success.")
+
     def act(self) -> Status:
-        self.skills.stop()
+        self.intents.stop()
         return Status.SUCCESS
 
 
+#: Every leaf by name: the registry (:mod:`pfctl.core.behavior.registry`) is derived from these
+#: classes' specs, conditions first.
 LEAF_CLASSES: dict[str, type[Leaf]] = {
-    "target_visible": TargetVisible,
-    "target_tracked": TargetTracked,
-    "target_lost_for": TargetLostFor,
-    "prediction_available": PredictionAvailable,
-    "near_target": NearTarget,
-    "follow_target": FollowTarget,
-    "gaze_at_target": GazeAtTarget,
-    "go_to_prediction": GoToPrediction,
-    "look_around": LookAround,
-    "waypoint_search": WaypointSearch,
-    "go_to_last_seen": GoToLastSeen,
-    "stop": Stop,
+    cls.spec.name: cls
+    for cls in (
+        TargetVisible,
+        TargetTracked,
+        TargetLostFor,
+        PredictionAvailable,
+        NearTarget,
+        FollowTarget,
+        GazeAtTarget,
+        GoToPrediction,
+        LookAround,
+        WaypointSearch,
+        GoToLastSeen,
+        Stop,
+    )
 }
-assert set(LEAF_CLASSES) == set(LEAF_SPECS), "every registered leaf has a behaviour"
 
 #: Search actions: when one of them runs while the target is lost, the robot is "predicted"
 #: (going to the prediction and looking there) or "searching" (Algorithm 1).
@@ -398,14 +524,15 @@ def leaf_factory(
     mission's values, e.g. ``follow_target.distance``)."""
 
     def make(kind: str, name: str, params: dict[str, Any]) -> py_trees.behaviour.Behaviour:
-        spec = LEAF_SPECS[name]
+        cls = LEAF_CLASSES[name]
+        spec = cls.spec
         if spec.kind != kind:
             raise ValueError(f"{name} is a {spec.kind}, not a {kind}")
         filled = dict(params)
         for key, value in (defaults or {}).get(name, {}).items():
             if filled.get(key) is None:
                 filled[key] = value
-        return LEAF_CLASSES[name](name, namespace, filled)
+        return cls(name, namespace, filled)
 
     return make
 

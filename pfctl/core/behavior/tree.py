@@ -52,9 +52,9 @@ __all__ = [
     "LEAVES",
     "NODE_KINDS",
     "Clock",
+    "EpisodeTimeout",
     "LayoutNode",
     "LeafFactory",
-    "SimTimeout",
     "build_tree",
     "parse_layout",
 ]
@@ -231,11 +231,12 @@ def parse_layout(layout: Mapping[str, Any], where: str = "behavior.tree") -> Lay
     )
 
 
-class SimTimeout(py_trees.decorators.Decorator):
+class EpisodeTimeout(py_trees.decorators.Decorator):
     """Fail the child when it has been RUNNING for ``seconds`` on ``clock`` (a decorator, §II-A).
 
-    py_trees' own ``Timeout`` reads the wall clock; the simulator runs faster (or slower) than
-    real time, so this one reads the episode's clock. The time is measured from the tick on
+    py_trees' own ``Timeout`` reads the wall clock; this one reads the episode's clock (the
+    simulated time in the simulator, which runs faster or slower than real time; ROS time on the
+    robot). The time is measured from the tick on
     which the child (re)starts, i.e. the decorator's ``initialise``. On the first tick the child
     is still RUNNING at ``clock() - start >= seconds`` the child is stopped (its ``terminate``
     sees INVALID, so an action cancels its goal) and the decorator returns FAILURE. A child that
@@ -322,7 +323,7 @@ def _build(node: LayoutNode, factory: LeafFactory, clock: Clock) -> py_trees.beh
         # py_trees' Repeat succeeds on the num_success-th success and fails on any failure.
         return py_trees.decorators.Repeat(name=name, child=child, num_success=int(node.value or 1))
     if node.kind == "timeout":
-        return SimTimeout(name=name, child=child, seconds=float(node.value or 0.0), clock=clock)
+        return EpisodeTimeout(name=name, child=child, seconds=float(node.value or 0.0), clock=clock)
     raise AssertionError(f"unhandled node kind {node.kind!r}")  # pragma: no cover
 
 
@@ -345,7 +346,7 @@ def build_tree(
     ``FailureIsSuccess``, force_failure → ``SuccessIsFailure`` (RUNNING stays RUNNING in both),
     retry → ``Retry(num_failures=attempts)`` (a failed run is retried on the next tick, at most
     ``attempts`` runs in all), repeat → ``Repeat(num_success=count)`` (one run per tick while it
-    succeeds), timeout → :class:`SimTimeout`.
+    succeeds), timeout → :class:`EpisodeTimeout`.
 
     Raises ValueError ``"<path>: <reason>"`` for a malformed layout, an unknown leaf or a bad
     parameter (see :func:`parse_layout`), and for a ValueError the factory raises.

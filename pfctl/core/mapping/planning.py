@@ -30,6 +30,10 @@ NEAR_COST = 4.0
 #: How far (m) a start inside the inflated obstacles may be moved to the nearest free cell.
 START_SNAP = 0.5
 
+#: How far (m) a goal (a predicted place, a way-point, where the target was seen) may be moved
+#: into free space for the robot (:meth:`GridPlanner.free_goal`).
+GOAL_SNAP = 1.5
+
 
 class NoPathError(ValueError):
     """No collision-free path: the goal is in (or too close to) an obstacle, or unreachable."""
@@ -121,6 +125,12 @@ class GridPlanner:
         d = np.linalg.norm(centres - p, axis=1)
         i = int(np.argmin(d))
         return centres[i] if d[i] <= max_distance else None
+
+    def free_goal(self, xy: ArrayLike) -> tuple[float, float] | None:
+        """``xy`` moved to the nearest cell free for the robot (within :data:`GOAL_SNAP`), or
+        None: where the robot can go to look at a place."""
+        p = self.nearest_free(np.asarray(xy, dtype=float), max_distance=GOAL_SNAP)
+        return None if p is None else (float(p[0]), float(p[1]))
 
     def with_obstacles(self, points: ArrayLike, radius: float) -> GridPlanner:
         """A copy whose map also has discs of ``radius`` m around ``points`` (n, 2) as obstacles.
@@ -269,4 +279,4 @@ def path_length(path: ArrayLike) -> float:
     return float(np.linalg.norm(np.diff(p, axis=0), axis=1).sum())
 
 
-__all__ = ["COMFORT_MARGIN", "GridPlanner", "NoPathError", "path_length"]
+__all__ = ["COMFORT_MARGIN", "GOAL_SNAP", "GridPlanner", "NoPathError", "path_length"]

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 from pfctl.core.episode import TrackRow
 from pfctl.core.perception.belief import HumanBelief
-from pfctl.core.perception.identity.identifier import TargetIdentifier, TrackIdentity
+from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier, TrackIdentity
 from pfctl.core.perception.legs.detector import LegDetections, LegDetector
 from pfctl.core.perception.tracking import (
     Detection,
@@ -134,6 +134,18 @@ class Perception:
             return None
         track_id = self.identifier.target_track()
         return None if track_id is None else self.tracker.track(track_id)
+
+    def not_target(self, exclude: int | None = None) -> list[tuple[float, float]]:
+        """Where the people are whose tracks Algorithm 2 has identified as not the target (track
+        ``exclude`` left out)."""
+        if self.identifier is None:
+            return []
+        others = {
+            tid
+            for tid, ident in self.identifier.identities().items()
+            if ident.decision is Decision.NOT_TARGET
+        }
+        return [t.position for t in self.tracks() if t.id in others and t.id != exclude]
 
     def seen_track_rows(self, stamp: float) -> list[TrackRow]:
         """One :func:`track_rows` row per confirmed track seen now (coasting tracks, which are

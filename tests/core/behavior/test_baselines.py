@@ -176,7 +176,7 @@ def test_the_cv_baseline_predicts_at_constant_velocity_where_the_svr_bends() -> 
         assert mission.prediction.model == name
         follower = build_follower(mission, _Idle(), _Idle())  # type: ignore[arg-type]
         try:
-            state = follower._predict(seen.t + 0.1, seen)
+            state = follower._fit_prediction(seen.t + 0.1, seen)
         finally:
             follower.close()
         assert state is not None
@@ -194,8 +194,8 @@ def test_the_cv_baseline_predicts_at_constant_velocity_where_the_svr_bends() -> 
 # --------------------------------------------------------------------------------------------
 
 
-class FakeSkills:
-    """Skills that record what the leaves ask for; ``go_to`` answers ``nav``."""
+class FakeIntents:
+    """Intents that record what the leaves ask for; ``go_to`` answers ``nav``."""
 
     def __init__(self) -> None:
         self.control = ControlParams()
@@ -237,7 +237,7 @@ class TreeRig:
         layout = yaml.safe_load((MISSIONS / "trees" / tree_file).read_text())
         self.ns = new_namespace()
         self.now = 0.0
-        self.skills = FakeSkills()
+        self.intents = FakeIntents()
         self.root = build_tree(
             layout, leaf_factory(self.ns, {"follow_target": {"distance": 1.0}}), lambda: self.now
         )
@@ -251,7 +251,7 @@ class TreeRig:
     ) -> tuple[Status, str | None]:
         self.now = now
         self.bb.t, self.bb.pose, self.bb.target = now, Pose2D(0.0, 0.0), target
-        self.bb.last_seen, self.bb.prediction, self.bb.skills = seen, None, self.skills
+        self.bb.last_seen, self.bb.prediction, self.bb.intents = seen, None, self.intents
         self.root.tick_once()
         tip = self.root.tip()
         return self.root.status, tip.name if tip is not None else None
@@ -265,11 +265,11 @@ def _target(now: float) -> TargetState:
 def test_the_reactive_tree_follows_and_otherwise_only_stops() -> None:
     rig = TreeRig("reactive.yaml")
     assert rig.tick(0.0, _target(0.0)) == (Status.RUNNING, "follow_target")
-    assert rig.skills.kinds() == ["follow"]
+    assert rig.intents.kinds() == ["follow"]
     seen = Sighting(0.0, (2.0, 1.0), np.array([[0.0, 2.0, 1.0]]))
     for k in range(1, 30):  # lost: stop, every tick, and nothing else
         assert rig.tick(k * 0.1, None, seen) == (Status.SUCCESS, "stop")
-        assert rig.skills.kinds() == ["stop"]
+        assert rig.intents.kinds() == ["stop"]
     assert rig.tick(3.0, _target(3.0), seen) == (Status.RUNNING, "follow_target")
 
 
@@ -277,29 +277,29 @@ def test_the_last_seen_tree_drives_there_then_looks_around_and_keeps_its_arrival
     rig = TreeRig("last_seen.yaml")
     seen = Sighting(0.0, (2.0, 1.0), np.array([[0.0, 2.0, 1.0]]))
     assert rig.tick(0.0, _target(0.0)) == (Status.RUNNING, "follow_target")
-    rig.skills.kinds()
+    rig.intents.kinds()
     # lost: RUNNING while driving to the last seen place
     assert rig.tick(1.0, None, seen) == (Status.RUNNING, "go_to_last_seen")
-    assert rig.skills.calls[-1] == ("go_to", (2.0, 1.0)) and rig.skills.kinds() == ["go_to"]
-    rig.skills.nav = "arrived"
+    assert rig.intents.calls[-1] == ("go_to", (2.0, 1.0)) and rig.intents.kinds() == ["go_to"]
+    rig.intents.nav = "arrived"
     # arrival: go_to_last_seen succeeds and look_around sweeps the head and turns the base
     assert rig.tick(1.1, None, seen) == (Status.RUNNING, "look_around")
-    assert rig.skills.kinds() == ["go_to", "pan", "turn"]
+    assert rig.intents.kinds() == ["go_to", "pan", "turn"]
     # drifting off the place while turning does not send the robot back: the arrival holds
-    rig.skills.nav = "running"
+    rig.intents.nav = "running"
     for k in range(2, 100):
         status, tip = rig.tick(1.0 + k * 0.1, None, seen)
         if tip != "look_around":
             break
-    assert "go_to" not in rig.skills.kinds()
+    assert "go_to" not in rig.intents.kinds()
     # the 8 s sweep ended without the target: one tick of stop, then looking again
     assert (status, tip) == (Status.SUCCESS, "stop") and rig.now == pytest.approx(9.1)
     assert rig.tick(9.2, None, seen) == (Status.RUNNING, "look_around")
     # a place that cannot be reached: failure, held for that sighting: stop, no re-planning
     other = Sighting(5.0, (9.0, 9.0), np.array([[5.0, 9.0, 9.0]]))
-    rig.skills.nav = "failed"
+    rig.intents.nav = "failed"
     assert rig.tick(10.0, None, other) == (Status.SUCCESS, "stop")
     assert rig.tick(10.1, None, other) == (Status.SUCCESS, "stop")
-    assert rig.skills.kinds().count("go_to") == 1
+    assert rig.intents.kinds().count("go_to") == 1
     # seen again: follow
     assert rig.tick(11.0, _target(11.0), other) == (Status.RUNNING, "follow_target")

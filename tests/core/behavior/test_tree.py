@@ -19,7 +19,7 @@ from py_trees.behaviour import Behaviour
 from py_trees.common import Status
 
 from pfctl.core.behavior.registry import LEAF_SPECS
-from pfctl.core.behavior.tree import SimTimeout, build_tree, parse_layout
+from pfctl.core.behavior.tree import EpisodeTimeout, build_tree, parse_layout
 from pfctl.mission import load_mission
 from pfctl.mission.tree import paper_tree
 from pfctl.plots.behavior_tree import ascii_tree, btcpp_xml, dot_tree, png_tree
@@ -278,7 +278,7 @@ def test_a_fallback_with_memory_keeps_ticking_the_running_child() -> None:
 def test_timeout_fails_a_long_running_child_on_the_given_clock() -> None:
     h = Harness(look_around=R)
     root = h.build({"timeout": {"seconds": 2.0, "child": action("look_around")}})
-    assert isinstance(root, SimTimeout) and root.name == "timeout 2 s"
+    assert isinstance(root, EpisodeTimeout) and root.name == "timeout 2 s"
     leaf = h.leaves["look_around"]
     assert tick(root) == R  # t = 0: started
     h.now = 1.9
