@@ -8,7 +8,7 @@ head commands, and drives ``move_base`` through actionlib:
   ``map → <scan frame>`` at the scan's stamp; the newest complete RGB-D frame (RGB, depth,
   camera info and, when configured, the person labels or the person keypoints of one stamp,
   paired within :data:`CAMERA_SLOP`; the keypoints become the frame's ``people``,
-  :mod:`pfctl.backends.hsr.person_keypoints`), the camera's optical frame from tf
+  :mod:`pfctl.bags.person_keypoints`), the camera's optical frame from tf
   ``map → <image frame>`` at the image's stamp; the base pose (tf ``map → base`` or the
   ``pose`` topic); the head from the joint states; the odometry; the collision count from the
   simulator's truth (0 without it). When tf has no ``map → odom`` at a stamp yet, the odom
@@ -52,9 +52,9 @@ from typing import Any
 
 from pfctl.backends.hsr import convert
 from pfctl.backends.hsr.master import MASTER_ERRORS, master_proxy
-from pfctl.backends.hsr.person_keypoints import people_from_cloud
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
+from pfctl.bags.person_keypoints import people_from_cloud
 from pfctl.bags.replay import image_labels
 from pfctl.core.perception.vision import GivenPersonDetector, MaskPersonDetector
 from pfctl.core.robot import (
@@ -136,7 +136,7 @@ def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
 
 def frame_people(msg: Any, topic: str, shape: tuple[int, int]) -> tuple[GivenPerson, ...]:
     """The people of a person-keypoints message (``sensor_msgs/PointCloud``,
-    :mod:`pfctl.backends.hsr.person_keypoints`) for an image of ``shape``;
+    :mod:`pfctl.bags.person_keypoints`) for an image of ``shape``;
     :class:`RobotDataError` naming ``topic`` and what was expected when it is malformed."""
     try:
         return people_from_cloud(msg, shape)

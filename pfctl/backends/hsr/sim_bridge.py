@@ -33,7 +33,7 @@ What is published when
        ``image_rect_raw``, or 32FC1 m), ``camera_info`` and ``person_labels`` (16UC1, see
        :mod:`pfctl.backends.hsr.person_labels`: the simulator's stand-in for OpenPose) or, when
        the mission sets it, ``person_keypoints`` (``sensor_msgs/PointCloud``, see
-       :mod:`pfctl.backends.hsr.person_keypoints`: the mask detector's people — box, head,
+       :mod:`pfctl.bags.person_keypoints`: the mask detector's people — box, head,
        neck, mid-hip, ankles — as BODY_25 keypoints and box corners, standing in for OpenPose
        too), all with the same stamp and frame ``head_rgbd_sensor_rgb_frame``;
     6. once per control period (and at ``t`` = 0): the truth for metrics, never for the follower:
@@ -90,10 +90,10 @@ import numpy as np
 
 from pfctl.backends.hsr import convert
 from pfctl.backends.hsr.master import master_proxy
-from pfctl.backends.hsr.person_keypoints import cloud_message, detection_parts
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
+from pfctl.bags.person_keypoints import cloud_message, detection_parts
 from pfctl.bags.recording import (
     CAMERA_FRAME,
     LASER_FRAME,
@@ -334,7 +334,7 @@ class HsrMessages:
 
     def person_keypoints(self, frame: RgbdFrame, people: list[PersonDetection]) -> Any:
         """``sensor_msgs/PointCloud`` of the mask detector's ``people`` in ``frame``
-        (:func:`~pfctl.backends.hsr.person_keypoints.detection_parts`, person = the simulator's
+        (:func:`~pfctl.bags.person_keypoints.detection_parts`, person = the simulator's
         instance index), with the frame's stamp and the camera's optical frame."""
         parts = {
             int(d.instance if d.instance is not None else i): detection_parts(d)

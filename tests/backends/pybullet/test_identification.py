@@ -14,8 +14,8 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.app.perception import identity_params
-from pfctl.backends.hsr.person_keypoints import detection_parts, given_person
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+from pfctl.bags.person_keypoints import detection_parts, given_person
 from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.perception.faces import FaceEncoder, face_distance
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
