@@ -52,7 +52,7 @@ def target_profile(
         except (OSError, ValueError) as err:
             raise UserError(f"--target {path}: {err}") from None
         return profile
-    from pfctl.commands.learn_target import learn_in_sim
+    from pfctl.app.learn_target import learn_in_sim
 
     with Progress(
         TextColumn("learning the target"),

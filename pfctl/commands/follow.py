@@ -51,7 +51,6 @@ from pfctl.app.episodes import (
     target_profile,
 )
 from pfctl.app.follower import EpisodeResult
-from pfctl.commands.replay import tracks_csv
 from pfctl.core.atomic_files import atomic_write_all
 from pfctl.core.metrics import (
     FollowMetrics,
@@ -62,6 +61,7 @@ from pfctl.core.metrics import (
 from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
+from pfctl.files import check_episode_dir, tracks_csv
 from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
@@ -260,9 +260,8 @@ def _recorder(record: Path | None, mission: Mission) -> EpisodeRecorder | None:
     if record is None:
         return None
     from pfctl.bags.recording import EpisodeRecorder, RecordingError
-    from pfctl.commands.sim import _check_episode_dir
 
-    _check_episode_dir(record)
+    check_episode_dir(record)
     try:
         return EpisodeRecorder(record, mission.name, images=False)
     except RecordingError as err:

@@ -34,6 +34,7 @@ from pfctl.core.mapping.grid import GridFileError
 from pfctl.core.mapping.planning import NoPathError
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
+from pfctl.files import check_episode_dir
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
@@ -102,7 +103,7 @@ def run(
     if teleop and not gui and not sys.stdin.isatty():
         raise UserError("--teleop: stdin is not a terminal; run it in a terminal or with --gui")
     if record is not None:
-        _check_episode_dir(record)
+        check_episode_dir(record)
     if png is None:
         png = record / "paths.png" if record is not None else Path("sim_run.png")
     if png.suffix.lower() != ".png":
@@ -171,16 +172,6 @@ def run(
     _report(loaded, result, robot.collisions, picture, record)
     if result.interrupted:
         raise typer.Exit(130)
-
-
-def _check_episode_dir(path: Path) -> None:
-    """Refuse to write an episode over a file or over a folder that holds something else."""
-    if path.exists() and not path.is_dir():
-        raise UserError(f"--record {path}: exists and is not a directory")
-    if path.is_dir() and any(path.iterdir()) and not (path / "episode.json").is_file():
-        raise UserError(
-            f"--record {path}: a folder that is neither empty nor an episode; choose another"
-        )
 
 
 class _Progress:
@@ -462,7 +453,7 @@ def _serve(
 def _posing(robot: SimRobot, source: str) -> Callable[[float], None]:
     """Hold the target in front of the robot (as ``pfctl learn-target`` does in the simulator),
     turning a little from side to side; the scene callback that keeps them there."""
-    from pfctl.commands.learn_target import SWAY, stand_in_front
+    from pfctl.app.learn_target import SWAY, stand_in_front
 
     x, y, _ = stand_in_front(robot, source=source)
     target = next(w for w in robot.people if w.is_target)

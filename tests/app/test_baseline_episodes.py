@@ -13,9 +13,9 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.app.episodes import LEARN_SECONDS, run_sim_episode
+from pfctl.app.learn_target import learn_in_sim
 from pfctl.app.perception import identity_params
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
 from pfctl.core.episode import TickRecord
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile

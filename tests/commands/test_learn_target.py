@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 from rich.progress import Progress
 
+from pfctl.app.learn_target import learn_from_images
 from pfctl.app.perception import identity_params
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import learn_from_images
 from pfctl.core.perception.clothes import histogram_intersection
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.perception.vision import MaskPersonDetector

@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from rich.progress import Progress
 
+from pfctl.app.learn_target import learn_in_sim
 from pfctl.app.perception import identity_params
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.bags.person_keypoints import detection_parts, given_person
-from pfctl.commands.learn_target import learn_in_sim
 from pfctl.core.perception.faces import FaceEncoder, face_distance
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
 from pfctl.core.perception.identity.profile import describe, learn_profile
