@@ -87,7 +87,7 @@ def run(
     """Run the simulated house: people walk their routes; the robot stands, replays a script or
     is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
     from pfctl.backends.pybullet import drivers
-    from pfctl.backends.pybullet.runner import graceful_interrupts, run_episode
+    from pfctl.backends.pybullet.runner import graceful_interrupts, run_simulation
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
     from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
     from pfctl.plots.sim_run import plot_episode
@@ -150,12 +150,12 @@ def run(
             with graceful_interrupts() as stop, _Progress(console, duration) as tick:
                 if teleop and not gui:
                     with drivers.TerminalKeys() as terminal:
-                        result = run_episode(
+                        result = run_simulation(
                             robot, duration, driver, recorder, terminal.read, tick, stop
                         )
                 else:
                     keys = (lambda: drivers.window_keys(robot.client)) if teleop else None
-                    result = run_episode(robot, duration, driver, recorder, keys, tick, stop)
+                    result = run_simulation(robot, duration, driver, recorder, keys, tick, stop)
             if recorder is not None:
                 recorder.close()
         except BaseException:
@@ -384,14 +384,14 @@ def _serve(
     from pfctl.backends.hsr.sim_bridge import (
         CLOCK_OFFSET,
         SimHsrBridge,
-        check_master,
         claim_sim_time,
         master_uri,
+        reach_master,
     )
 
     import_rospy()  # ROS 1 missing: one line naming the apt packages
     uri = master_uri()
-    check_master(uri)
+    reach_master(uri)
     claim_sim_time(uri)  # before the simulator loads: a node reads /use_sim_time as it starts
     from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 

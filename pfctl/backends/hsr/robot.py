@@ -51,7 +51,7 @@ from dataclasses import replace
 from typing import Any
 
 from pfctl.backends.hsr import convert
-from pfctl.backends.hsr.master import MASTER_ERRORS, master_proxy
+from pfctl.backends.hsr.master import MASTER_ERRORS, MasterError, check_master, master_proxy
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
 from pfctl.bags.person_keypoints import people_from_cloud
@@ -76,6 +76,8 @@ from pfctl.core.tf_buffer import quaternion_matrix
 from pfctl.errors import UserError
 from pfctl.mission import HsrConfig, Mission
 
+MASTER_CHECK_TIMEOUT = 2.0
+"""Wall seconds the ROS master may take to answer at start."""
 CAMERA_SLOP = 0.02
 """Seconds by which the stamps of one RGB-D frame's images may differ (serve-hsr: 0)."""
 TF_WAIT = 0.25
@@ -104,18 +106,18 @@ class RobotDataError(UserError):
 # ------------------------------------------------------------------------------------- helpers
 
 
-def check_master(uri: str, timeout: float = 2.0) -> None:
+def _connect_master(uri: str) -> None:
     """Raise :class:`RobotConnectionError` unless the ROS master at ``uri`` answers within
-    ``timeout`` seconds (rospy would block forever in ``init_node``)."""
+    :data:`MASTER_CHECK_TIMEOUT` seconds (rospy would block forever in ``init_node``)."""
     try:
-        code, message, _ = master_proxy(uri, timeout).getPid("/pfctl_check")
-    except MASTER_ERRORS as err:
+        check_master(uri, "/pfctl_check", MASTER_CHECK_TIMEOUT)
+    except MasterError as err:
+        if err.error is None:
+            raise RobotConnectionError(f"the ROS master at {uri} answered: {err.answer}") from None
         raise RobotConnectionError(
-            f"cannot reach the ROS master at {uri} ({err}): start roscore, or point "
+            f"cannot reach the ROS master at {uri} ({err.error}): start roscore, or point "
             "ROS_MASTER_URI at the robot's master"
         ) from None
-    if code != 1:
-        raise RobotConnectionError(f"the ROS master at {uri} answered: {message}")
 
 
 def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
@@ -228,7 +230,7 @@ class HsrRobot:
         rosgraph = import_ros_module("rosgraph")
         self.master_uri = str(rosgraph.get_master_uri())
         """The ROS master this robot talks to (``ROS_MASTER_URI``)."""
-        check_master(self.master_uri)
+        _connect_master(self.master_uri)
         self.node = _ensure_node(rospy, node_name)
         """This process's node name."""
         self.use_sim_time = not rospy.rostime.is_wallclock()
@@ -1074,7 +1076,6 @@ __all__ = [
     "HsrRobot",
     "RobotConnectionError",
     "RobotDataError",
-    "check_master",
     "frame_people",
     "people_from_markers",
 ]

@@ -74,7 +74,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import http.client
 import math
 import os
 import queue
@@ -89,7 +88,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pfctl.backends.hsr import convert
-from pfctl.backends.hsr.master import master_proxy
+from pfctl.backends.hsr.master import MasterError, check_master, master_proxy
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
@@ -125,7 +124,7 @@ end)."""
 OFFSET_PARAM = "/pfctl/sim/clock_offset"
 SEED_PARAM = "/pfctl/sim/seed"
 DEPTH_ENCODINGS = ("16UC1", "32FC1")
-MASTER_TIMEOUT = 3.0
+MASTER_CHECK_TIMEOUT = 3.0
 """Wall seconds the master may take to answer before it counts as missing."""
 PEER_WAIT = 3.0
 """Wall seconds to wait for subscribers (and publishers) the master already knows to connect."""
@@ -165,18 +164,20 @@ def master_uri() -> str:
     return uri
 
 
-def check_master(uri: str, timeout: float = MASTER_TIMEOUT) -> None:
-    """A UserError (one line) unless a ROS master answers at ``uri`` within ``timeout`` seconds
-    (``rospy.init_node`` would wait for it forever)."""
+def reach_master(uri: str) -> None:
+    """A UserError (one line) unless a ROS master answers at ``uri`` within
+    :data:`MASTER_CHECK_TIMEOUT` seconds (``rospy.init_node`` would wait for it forever)."""
     try:
-        code, message, _ = master_proxy(uri, timeout).getPid("/" + NODE_NAME)
-    except (OSError, xmlrpc.client.Error, http.client.HTTPException, ValueError) as err:
-        reason = getattr(err, "strerror", None) or str(err) or type(err).__name__
+        check_master(uri, "/" + NODE_NAME, MASTER_CHECK_TIMEOUT)
+    except MasterError as err:
+        if err.error is None:
+            raise UserError(
+                f"the ROS master at {uri} does not answer getPid: {err.answer}"
+            ) from None
+        reason = getattr(err.error, "strerror", None) or str(err.error) or type(err.error).__name__
         raise UserError(
             f"no ROS master at {uri} ({reason}); start roscore or set ROS_MASTER_URI"
         ) from None
-    if code != 1:
-        raise UserError(f"the ROS master at {uri} does not answer getPid: {message}")
 
 
 def claim_sim_time(uri: str) -> None:
@@ -846,9 +847,9 @@ __all__ = [
     "BridgeStats",
     "HsrMessages",
     "SimHsrBridge",
-    "check_master",
     "claim_sim_time",
     "master_proxy",
     "master_uri",
+    "reach_master",
     "ros_time",
 ]

@@ -1,6 +1,6 @@
 """Running the simulated house for a while: step, drive, record, keep the truth (``pfctl sim run``).
 
-:func:`run_episode` steps a :class:`SimRobot` for ``duration`` simulated seconds. Each control
+:func:`run_simulation` steps a :class:`SimRobot` for ``duration`` simulated seconds. Each control
 period it asks the driver (a script, the keyboard, or none: the robot stands still) for a
 command, steps the simulator, hands the observation and the ground truth to the recorder, and
 keeps the truth for the picture. Inside :func:`graceful_interrupts`, Ctrl-C ends the run between
@@ -47,7 +47,7 @@ class RunResult:
         return self.sim_time / self.wall_time if self.wall_time > 0 else float("inf")
 
 
-def run_episode(
+def run_simulation(
     robot: SimRobot,
     duration: float,
     driver: Driver | None = None,
@@ -96,4 +96,4 @@ def run_episode(
     return result
 
 
-__all__ = ["Driver", "RunResult", "StopFlag", "graceful_interrupts", "run_episode"]
+__all__ = ["Driver", "RunResult", "StopFlag", "graceful_interrupts", "run_simulation"]
