@@ -129,13 +129,14 @@ def learn_in_sim(
     source: str = "mission",
 ) -> Learned:
     """Frames of the target posing in front of the simulated robot (see the module docstring)."""
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.app.sim import sim_config
+    from pfctl.backends.pybullet.simulation import SimRobot
     from pfctl.core.perception.vision import MaskPersonDetector
 
     learned = Learned([])
     encoder = FaceEncoder(params.face)
     cam = mission.sensors.camera
-    with SimRobot(mission, SimOptions(seed=seed)) as robot:
+    with SimRobot(sim_config(mission, seed)) as robot:
         x, y, bearing = stand_in_front(robot, source=source)
         target = next(w for w in robot.people if w.is_target)
         facing = target.theta
@@ -209,9 +210,10 @@ def learn_on_hsr(
 ) -> Learned:
     """:func:`learn_on_robot` on the HSR over ROS 1 (``backend.hsr``); a robot lost meanwhile
     raises :class:`~pfctl.core.robot.RobotLostError` (its base stopped)."""
+    from pfctl.app.hsr import hsr_config
     from pfctl.backends.hsr.robot import HsrRobot
 
-    with HsrRobot(mission, node_name="pfctl_learn_target") as robot:
+    with HsrRobot(hsr_config(mission), node_name="pfctl_learn_target") as robot:
         detector = robot.person_detector()
         if detector is None:
             raise UserError(

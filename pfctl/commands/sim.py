@@ -31,7 +31,6 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
 from pfctl.core.mapping.grid import GridFileError
-from pfctl.core.mapping.planning import NoPathError
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
 from pfctl.files import check_episode_dir
@@ -86,9 +85,10 @@ def run(
 ) -> None:
     """Run the simulated house: people walk their routes; the robot stands, replays a script or
     is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
+    from pfctl.app.sim import sim_robot
     from pfctl.backends.pybullet import drivers
     from pfctl.backends.pybullet.runner import graceful_interrupts, run_simulation
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.backends.pybullet.simulation import SimOptions
     from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
     from pfctl.plots.sim_run import plot_episode
 
@@ -118,16 +118,12 @@ def run(
         except drivers.ScriptError as err:
             raise UserError(str(err)) from None
     options = SimOptions(
-        seed=seed,
         gui=gui,
         realtime=realtime or teleop,
         camera=camera,
         laser_model="bullet" if laser == "bullet" else "fast",
     )
-    try:
-        robot = SimRobot(loaded, options)
-    except NoPathError as err:
-        raise UserError(f"{mission}: scenario.people: a route cannot be walked: {err}") from None
+    robot = sim_robot(loaded, seed, str(mission), options)
     console = Console(stderr=True)
     with robot:
         driver: drivers.ScriptedDriver | drivers.KeyboardDriver | None = None
@@ -393,22 +389,21 @@ def _serve(
     uri = master_uri()
     reach_master(uri)
     claim_sim_time(uri)  # before the simulator loads: a node reads /use_sim_time as it starts
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.app.hsr import hsr_config
+    from pfctl.app.sim import sim_robot
 
-    try:
-        robot = SimRobot(mission, SimOptions(seed=seed))
-    except NoPathError as err:
-        raise UserError(f"{path}: scenario.people: a route cannot be walked: {err}") from None
+    robot = sim_robot(mission, seed, str(path))
     with robot:
         scene = None
         if hide is not None:
             from pfctl.app.episodes import hide_target
 
-            hide_target(robot, hide)
+            hide_target(mission, robot, hide)
         elif pose_target:
             scene = _posing(robot, str(path))
         bridge = SimHsrBridge(
             robot,
+            hsr_config(mission),
             uri,
             rate=rate,
             depth_encoding=depth_encoding,

@@ -15,7 +15,8 @@ from rich.progress import Progress
 from pfctl.app.episodes import LEARN_SECONDS, run_sim_episode
 from pfctl.app.learn_target import learn_in_sim
 from pfctl.app.perception import identity_params
-from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
 from pfctl.core.episode import TickRecord
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
@@ -37,7 +38,7 @@ def profile() -> TargetProfile:
 
 def _episode(path: Path, profile: TargetProfile) -> list[TickRecord]:
     mission = load_mission(path)
-    with SimRobot(mission, SimOptions(seed=SEED)) as robot:
+    with SimRobot(sim_config(mission, SEED)) as robot:
         result = run_sim_episode(mission, robot, profile, SECONDS)
     return result.log.ticks
 

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
+from pfctl.backends.pybullet.config import LaserConfig
 from pfctl.core.robot import LaserScan, Pose2D
-from pfctl.mission import LaserConfig
 
 
 @dataclass(frozen=True)
@@ -44,7 +44,7 @@ class LaserSpec:
 
     @classmethod
     def from_config(cls, cfg: LaserConfig) -> LaserSpec:
-        """The spec of a mission's ``sensors.laser`` (field of view centred ahead)."""
+        """The spec of the simulated laser (field of view centred ahead)."""
         beams = math.floor(cfg.fov_deg / cfg.resolution_deg + 1e-9) + 1
         if cfg.fov_deg >= 360.0:
             beams -= 1  # a full circle: the last beam would repeat the first

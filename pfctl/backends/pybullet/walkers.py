@@ -20,9 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from pfctl.backends.pybullet.config import PersonConfig, ScenarioConfig
+from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import PersonTruth
-from pfctl.mission import Mission, Person
 
 #: A person's footprint for planning, metres.
 PERSON_RADIUS = 0.25
@@ -267,14 +268,14 @@ class Walker:
 
 
 def _stops(
-    mission: Mission,
-    person: Person,
+    scenario: ScenarioConfig,
+    layout: HouseLayout,
+    person: PersonConfig,
     planner: GridPlanner,
     rng: np.random.Generator,
     jitter_rng: np.random.Generator | None = None,
 ) -> list[np.ndarray]:
-    layout = mission.layout()
-    jitter = mission.scenario.randomize.route_jitter
+    jitter = scenario.randomize.route_jitter
     out = []
     for stop in person.route:
         if isinstance(stop, str):
@@ -285,13 +286,13 @@ def _stops(
                 raise NoPathError(f"{person.name}: route point {stop} is not free for a person")
             point = np.asarray(p, dtype=float)
             if jitter > 0 and jitter_rng is not None:
-                point = _jittered(mission, planner, point, jitter, jitter_rng)
+                point = _jittered(layout, planner, point, jitter, jitter_rng)
             out.append(point)
     return out
 
 
 def _jittered(
-    mission: Mission,
+    layout: HouseLayout,
     planner: GridPlanner,
     point: np.ndarray,
     jitter: float,
@@ -300,7 +301,7 @@ def _jittered(
 ) -> np.ndarray:
     """``point`` moved by up to ``jitter`` metres (uniform over the disc) to a free spot of the
     same region (``scenario.randomize.route_jitter``); ``point`` itself if no draw lands there."""
-    regions = [shapely.Polygon(r.polygon) for r in mission.layout().regions]
+    regions = [shapely.Polygon(r.polygon) for r in layout.regions]
     home = next((r for r in regions if r.covers(shapely.Point(point))), None)
     for _ in range(tries):
         r = jitter * math.sqrt(float(rng.uniform()))
@@ -312,7 +313,8 @@ def _jittered(
 
 
 def _random_walkers(
-    mission: Mission,
+    scenario: ScenarioConfig,
+    layout: HouseLayout,
     planner: GridPlanner,
     rng: np.random.Generator,
     taken: set[str],
@@ -324,9 +326,8 @@ def _random_walkers(
 ) -> list[Walker]:
     """``count`` (default ``scenario.random_people``) distractors: random free stops, clothes
     and speed; with ``dress_like``, clothes within ``jitter`` of those per RGB channel."""
-    layout = mission.layout()
     walkers = []
-    for i in range(mission.scenario.random_people if count is None else count):
+    for i in range(scenario.random_people if count is None else count):
         name = f"{prefix}_{i}"
         while name in taken:
             name += "_"
@@ -359,10 +360,12 @@ def _random_walkers(
     return walkers
 
 
-def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
-    """The scenario's people (plus ``random_people`` distractors, and what
-    ``scenario.randomize`` adds: speeds, moved route points, extra distractors and look-alikes
-    dressed like the target), deterministic for ``seed``.
+def make_walkers(
+    scenario: ScenarioConfig, layout: HouseLayout, planner: GridPlanner, seed: int
+) -> list[Walker]:
+    """The scenario's people in the house ``layout`` (plus ``random_people`` distractors, and
+    what ``scenario.randomize`` adds: speeds, moved route points, extra distractors and
+    look-alikes dressed like the target), deterministic for ``seed``.
 
     ``planner`` may be the robot's: routes are planned with a copy for :data:`PERSON_RADIUS`.
     Raises :class:`NoPathError` if a route cannot be walked.
@@ -370,13 +373,13 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
     if abs(planner.robot_radius - PERSON_RADIUS) > 1e-9:
         planner = planner.with_radius(PERSON_RADIUS)
     rng = np.random.default_rng(seed)
-    vary = mission.scenario.randomize
+    vary = scenario.randomize
     # scenario.randomize draws from streams of its own: the draws above stay as they were
     speed_rng, jitter_rng, extra_rng = (
         np.random.default_rng([seed, RANDOMIZE, k]) for k in range(3)
     )
     walkers = []
-    for person in mission.scenario.people:
+    for person in scenario.people:
         clothes = WalkerClothes(
             tuple(int(v) for v in person.clothes.upper),  # type: ignore[arg-type]
             tuple(int(v) for v in person.clothes.lower),  # type: ignore[arg-type]
@@ -388,27 +391,30 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
         walkers.append(
             Walker(
                 person.name,
-                _stops(mission, person, planner, rng, jitter_rng),
+                _stops(scenario, layout, person, planner, rng, jitter_rng),
                 planner,
                 speed=speed,
                 clothes=clothes,
                 height=person.height,
                 pause_s=person.pause_s,
                 loop=person.loop,
-                is_target=person.name == mission.scenario.target,
+                is_target=person.name == scenario.target,
                 seed=int(rng.integers(2**31)),
             )
         )
-    walkers += _random_walkers(mission, planner, rng, {w.name for w in walkers})
+    walkers += _random_walkers(scenario, layout, planner, rng, {w.name for w in walkers})
     extra = int(extra_rng.integers(vary.extra_people[0], vary.extra_people[1] + 1))
     alikes = int(extra_rng.integers(vary.look_alikes[0], vary.look_alikes[1] + 1))
     if extra:
         taken = {w.name for w in walkers}
-        walkers += _random_walkers(mission, planner, extra_rng, taken, extra, prefix="extra")
+        walkers += _random_walkers(
+            scenario, layout, planner, extra_rng, taken, extra, prefix="extra"
+        )
     target = next((w for w in walkers if w.is_target), None)
     if alikes and target is not None:
         walkers += _random_walkers(
-            mission,
+            scenario,
+            layout,
             planner,
             extra_rng,
             {w.name for w in walkers},

@@ -321,6 +321,7 @@ def test_missing_laser_is_one_line_naming_the_topic(ros_master, ros_nodes):
 
 def test_unreachable_master_is_one_line(ros, monkeypatch):
     """No master: a clear error before rospy's init_node (which would block forever)."""
+    from pfctl.app.hsr import hsr_config
     from pfctl.backends.hsr.robot import HsrRobot, RobotConnectionError
     from pfctl.mission import load_mission
 
@@ -330,7 +331,7 @@ def test_unreachable_master_is_one_line(ros, monkeypatch):
     monkeypatch.setenv("ROS_MASTER_URI", uri)
     mission = load_mission(Path(__file__).parents[3] / "missions" / "house.yaml")
     with pytest.raises(RobotConnectionError) as info:
-        HsrRobot(mission)
+        HsrRobot(hsr_config(mission))
     message = str(info.value)
     assert message.startswith(f"cannot reach the ROS master at {uri} (")
     assert "\n" not in message and info.value.exit_code == 2
