@@ -65,7 +65,8 @@ class PoseNoise:
 
 @dataclass(frozen=True)
 class Clothes:
-    """A person's clothes colours, RGB 0..255 (``scenario.people[*].clothes``)."""
+    """A person's clothes colours, RGB 0..255 (``scenario.people[*].clothes``; also the
+    simulator's distractors')."""
 
     upper: tuple[int, int, int]
     lower: tuple[int, int, int]

@@ -32,9 +32,9 @@ import pybullet as p
 import shapely
 from shapely.geometry.polygon import orient
 
-from pfctl.backends.pybullet.config import HouseConfig
+from pfctl.backends.pybullet.config import Clothes, HouseConfig
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec
-from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker, WalkerClothes
+from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker
 from pfctl.backends.pybullet.world import build_world, ccw_ring, outline
 from pfctl.core.robot import LaserScan, Pose2D
 
@@ -198,7 +198,7 @@ class LegScanGenerator:
                 [pt],
                 cast(Any, None),  # one stop: no route to plan
                 speed=1.0,
-                clothes=WalkerClothes((0, 0, 0), (0, 0, 0)),
+                clothes=Clothes((0, 0, 0), (0, 0, 0)),
             )
             walker.theta = float(rng.uniform(-math.pi, math.pi))
             if rng.random() < 0.45:  # standing: legs together, or weight shifted

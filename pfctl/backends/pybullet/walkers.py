@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
-from pfctl.backends.pybullet.config import PersonConfig, ScenarioConfig
+from pfctl.backends.pybullet.config import Clothes, PersonConfig, ScenarioConfig
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import PersonTruth
@@ -42,14 +42,6 @@ RANDOMIZE = 7919
 
 
 @dataclass(frozen=True)
-class WalkerClothes:
-    """Clothes colours, RGB 0..255."""
-
-    upper: tuple[int, int, int]
-    lower: tuple[int, int, int]
-
-
-@dataclass(frozen=True)
 class WalkerState:
     """A person at one instant: pose, speed, looks and leg positions (map frame)."""
 
@@ -60,7 +52,7 @@ class WalkerState:
     speed: float
     is_target: bool
     height: float
-    clothes: WalkerClothes
+    clothes: Clothes
     legs: np.ndarray
     """Rows ``[x, y, radius]`` of the two legs."""
     paused: bool = False
@@ -104,7 +96,7 @@ class Walker:
         planner: GridPlanner,
         *,
         speed: float,
-        clothes: WalkerClothes,
+        clothes: Clothes,
         height: float = 1.7,
         pause_s: float = 2.0,
         loop: bool = False,
@@ -321,7 +313,7 @@ def _random_walkers(
     count: int | None = None,
     *,
     prefix: str = "walker",
-    dress_like: WalkerClothes | None = None,
+    dress_like: Clothes | None = None,
     jitter: int = 0,
 ) -> list[Walker]:
     """``count`` (default ``scenario.random_people``) distractors: random free stops, clothes
@@ -336,12 +328,12 @@ def _random_walkers(
         for r in regions:
             stops.append(_region_point(planner, layout.regions[int(r)].polygon, rng))
         if dress_like is None:
-            clothes = WalkerClothes(
+            clothes = Clothes(
                 tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
                 tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
             )
         else:
-            clothes = WalkerClothes(
+            clothes = Clothes(
                 _near(dress_like.upper, jitter, rng), _near(dress_like.lower, jitter, rng)
             )
         walkers.append(
@@ -380,7 +372,7 @@ def make_walkers(
     )
     walkers = []
     for person in scenario.people:
-        clothes = WalkerClothes(
+        clothes = Clothes(
             tuple(int(v) for v in person.clothes.upper),  # type: ignore[arg-type]
             tuple(int(v) for v in person.clothes.lower),  # type: ignore[arg-type]
         )
@@ -432,4 +424,4 @@ def _near(rgb: tuple[int, int, int], jitter: int, rng: np.random.Generator) -> t
     return tuple(int(v) for v in np.clip(moved, 0, 255))  # type: ignore[return-value]
 
 
-__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerClothes", "WalkerState", "make_walkers"]
+__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerState", "make_walkers"]
