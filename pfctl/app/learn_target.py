@@ -181,8 +181,8 @@ def learn_on_robot(
     stands still, the head looks straight ahead and nods between a face at
     :data:`FACE_HEIGHT` and a body at :data:`BODY_HEIGHT`; the person is the detection nearest
     the spot in front of the robot (within :data:`SPOT_RADIUS`). The frames are kept and learned
-    from once the robot has been told to stand still for good: a face embedding (~0.1 s, holding
-    the interpreter) must not starve the robot's message threads while its watchdog runs."""
+    from once the robot has been told to stand still for good: a face embedding, holding the
+    interpreter, must not starve the robot's message threads while its watchdog runs."""
     learned = Learned([])
     frames: list[RgbdFrame] = []
     start = now()

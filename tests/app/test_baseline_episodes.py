@@ -1,5 +1,5 @@
 """The reactive baseline against the paper's tree on the paper's episode (seed 1, §III-B): both
-follow Alice out of the kitchen and lose her at the office door (~9.9 s); the reactive baseline
+follow Alice out of the kitchen and lose her at the office door; the reactive baseline
 (``missions/baselines/house_reactive.yaml``) then stops and never searches, while the paper's
 tree (Fig. 2) goes to the prediction and searches. One target profile learned for both runs;
 15 s simulated each."""

@@ -15,7 +15,7 @@ import time
 import numpy as np
 
 NODE_TIMEOUT = 60.0
-"""Wall seconds a node may take (it takes ~1-2 s here)."""
+"""Wall seconds a node may take."""
 
 NODE_PRELUDE = """
 import json, sys

@@ -35,11 +35,9 @@ NODES = Path(__file__).parent / "nodes"
 TOPIC = "/pfctl/person_keypoints"
 SHAPE = (240, 320)
 #: Horizontal distance (m) within which every person the GivenPersonDetector places from the
-#: served keypoints lies from the simulator's truth at the frame's stamp. Measured on the house's
-#: episode held until the robot's first command (alice ahead of the robot, walking away): first
-#: 10 frames max 0.036 m, median 0.028 m; first 30 frames max 0.089 m, median 0.031 m (the label
-#: detector on the same frames: max 0.064 m, median 0.022 m). The test looks at 10 frames; a
-#: loaded machine may skip some and reach later ones.
+#: served keypoints lies from the simulator's truth at the frame's stamp, on the house's episode
+#: held until the robot's first command (alice ahead of the robot, walking away). The test looks
+#: at 10 frames; a loaded machine may skip some and reach later ones.
 TRUTH_TOLERANCE = 0.12
 
 

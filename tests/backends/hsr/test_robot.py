@@ -23,7 +23,7 @@ import pytest
 
 NODES = Path(__file__).parent / "nodes"
 WAIT = 30.0
-"""Wall seconds any one expected line may take (they take ~1-3 s here)."""
+"""Wall seconds any one expected line may take."""
 BAD_BEAMS = (10, 20, 30, 40, 50)  # fake_hsr.BAD_BEAMS: NaN, +inf, -inf, < range_min, > range_max
 N_BEAMS = 181
 BASE = (1.5, 2.0, math.pi / 2)  # fake_hsr: map→odom ⊕ odom→base_footprint
