@@ -87,7 +87,7 @@ def run(
     is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
     from pfctl.app.sim import sim_robot
     from pfctl.backends.pybullet import drivers
-    from pfctl.backends.pybullet.runner import graceful_interrupts, run_simulation
+    from pfctl.backends.pybullet.runner import run_simulation
     from pfctl.backends.pybullet.simulation import SimOptions
     from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
     from pfctl.plots.sim_run import plot_episode

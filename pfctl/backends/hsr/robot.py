@@ -125,8 +125,8 @@ def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
     (:func:`pfctl.bags.recording.person_marker`: ``ns`` = name, pose = position and
     heading, ``text`` = ``"target speed=0.800"``); markers that are not ADD are skipped.
 
-    The decoder is the simulator's (imported here, not at module level: a real robot publishes
-    no truth and its process never loads the PyBullet backend)."""
+    The decoder is the episode recorder's (imported here, not at module level: a real robot
+    publishes no truth, and the bag writer beside the decoder loads slowly)."""
     from pfctl.bags.recording import person_from_marker
 
     return tuple(
