@@ -420,12 +420,13 @@ def run_once(
     worker (closed; its stats kept) and the pacer."""
     from rich.console import Console
 
-    from pfctl.app.episodes import run_sim_episode, sim_robot, target_profile
+    from pfctl.app.episodes import run_sim_episode, target_profile
     from pfctl.app.perception import identity_params
+    from pfctl.app.sim import sim_robot
     from pfctl.core.perception.face_worker import FaceWorker
 
     profile = target_profile(mission, None, seed, Console(stderr=True), source)
-    robot = sim_robot(mission, seed, False, source)
+    robot = sim_robot(mission, seed, source)
     worker = None
     if not mode.sync and len(profile.faces):
         # the loop is pinned to CPU 0: the worker too, at the lowest priority

@@ -39,7 +39,8 @@ import cv2  # noqa: E402
 import dlib  # noqa: E402
 import numpy as np  # noqa: E402
 
-from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
+from pfctl.app.sim import sim_config  # noqa: E402
+from pfctl.backends.pybullet.simulation import SimRobot  # noqa: E402
 from pfctl.core.perception.clothes import convert  # noqa: E402
 from pfctl.core.perception.faces import FaceEncoder  # noqa: E402
 from pfctl.core.perception.identity.identifier import TargetIdentifier  # noqa: E402
@@ -97,7 +98,7 @@ def run(w: int, h: int, frames: int) -> dict[str, list[float]]:
     mission = loads_mission(SCENE.format(w=w, h=h), source="bench.yaml")
     params = IdentityParams()
     encoder = FaceEncoder(params.face)
-    with SimRobot(mission, SimOptions()) as robot:
+    with SimRobot(sim_config(mission)) as robot:
         detector = MaskPersonDetector(robot.person_instances(), robot.people_bodies.parts())
         shots = render(robot, frames + WARMUP)
     target = 0  # alice is instance 0

@@ -30,6 +30,7 @@ from typing import Any  # noqa: E402
 import numpy as np  # noqa: E402
 
 from pfctl.app.leg_models import load_leg_model  # noqa: E402
+from pfctl.app.sim import house_config  # noqa: E402
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec  # noqa: E402
 from pfctl.backends.pybullet.leg_scans import LegScanGenerator  # noqa: E402
 from pfctl.backends.pybullet.walkers import HIP_WIDTH, LEG_RADIUS  # noqa: E402
@@ -47,7 +48,7 @@ HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 
 def crowd_scan(people: int = 10) -> LaserScan:
     """The living room seen from (5.6, 2, 0°) with ``people`` pairs of legs 1–5 m ahead."""
-    gen = LegScanGenerator(load_mission(HOUSE))
+    gen = LegScanGenerator(house_config(load_mission(HOUSE)))
     laser = FastLaser(gen.segments, LaserSpec(noise_std=0.01), seed=0, one_sided=True)
     pose = Pose2D(5.6, 2.0, 0.0)
     rng = np.random.default_rng(0)

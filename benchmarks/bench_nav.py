@@ -26,6 +26,7 @@ from pathlib import Path  # noqa: E402
 import numpy as np  # noqa: E402
 import pybullet as p  # noqa: E402
 
+from pfctl.app.sim import sim_config  # noqa: E402
 from pfctl.backends.pybullet.navigation import Navigator  # noqa: E402
 from pfctl.backends.pybullet.people_bodies import PeopleBodies  # noqa: E402
 from pfctl.backends.pybullet.walkers import make_walkers  # noqa: E402
@@ -68,7 +69,7 @@ def main() -> None:
     pose = Pose2D(*start)
     nav.start(Pose2D(*goal), pose)
     scan_pts = np.column_stack((np.linspace(0, 12, 1081), np.full(1081, 4.0)))
-    walkers = make_walkers(mission, planner, seed=7)
+    walkers = make_walkers(sim_config(mission).scenario, mission.layout(), planner, seed=7)
     client = p.connect(p.DIRECT)
     bodies = PeopleBodies(client, walkers, seed=7)
 

@@ -30,6 +30,7 @@ from collections.abc import Callable  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import Any  # noqa: E402
 
+from pfctl.app.sim import sim_config  # noqa: E402
 from pfctl.backends.pybullet import simulation  # noqa: E402
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot  # noqa: E402
 from pfctl.core.mapping.regions import RegionMap  # noqa: E402
@@ -56,7 +57,7 @@ def run(mission: Mission, options: SimOptions, duration: float) -> dict[str, flo
     goals = [Pose2D(*regions.region_point(name)) for name in TOUR]
     scans: list[float] = []
     frames: list[float] = []
-    with SimRobot(mission, options) as robot:
+    with SimRobot(sim_config(mission), options) as robot:
         robot.laser.scan = _timed(robot.laser.scan, scans)  # type: ignore[method-assign]
         if robot.camera is not None:
             robot.camera.render = _timed(robot.camera.render, frames)  # type: ignore[method-assign]

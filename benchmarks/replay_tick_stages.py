@@ -99,13 +99,14 @@ def record(path: Path, duration: float) -> None:
     """Run the crowd episode and pickle what the follower observed."""
     from rich.console import Console
 
-    from pfctl.app.episodes import run_sim_episode, sim_robot, target_profile
+    from pfctl.app.episodes import run_sim_episode, target_profile
+    from pfctl.app.sim import sim_robot
     from pfctl.core.perception.vision import MaskPersonDetector
     from pfctl.mission import load_mission
 
     mission = load_mission(CROWD)
     profile = target_profile(mission, None, None, Console(stderr=True), str(CROWD))
-    robot = sim_robot(mission, None, False, str(CROWD))
+    robot = sim_robot(mission, None, str(CROWD))
     observations: list[Any] = []
     kept: dict[str, Any] = {"observations": observations, "profile": profile}
     with robot:

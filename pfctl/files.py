@@ -16,7 +16,7 @@ from pathlib import Path
 
 from pfctl.errors import UserError
 
-__all__ = ["atomic_write", "atomic_write_all", "write_output"]
+__all__ = ["atomic_write", "atomic_write_all", "check_episode_dir", "write_output"]
 
 
 def atomic_write(path: str | os.PathLike[str], data: str | bytes) -> Path:
@@ -72,3 +72,14 @@ def _write_temporary(target: Path, data: str | bytes) -> str:
             os.unlink(tmp)
         raise
     return tmp
+
+
+def check_episode_dir(path: Path) -> None:
+    """Refuse to write an episode (``--record``) over a file or over a folder that holds
+    something else."""
+    if path.exists() and not path.is_dir():
+        raise UserError(f"--record {path}: exists and is not a directory")
+    if path.is_dir() and any(path.iterdir()) and not (path / "episode.json").is_file():
+        raise UserError(
+            f"--record {path}: a folder that is neither empty nor an episode; choose another"
+        )

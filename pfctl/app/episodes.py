@@ -1,8 +1,8 @@
 """Running one episode of the follower: on the simulated house or on any robot of the Robot port.
 
 What ``pfctl follow`` / ``pfctl search`` and ``pfctl bench`` share, apart from the command line:
-the target's profile (read, or learned in the simulator first: :func:`target_profile`), the
-simulated robot (:func:`sim_robot`), hiding the target for a search (:func:`hide_target`), and the
+the target's profile (read, or learned in the simulator first: :func:`target_profile`), hiding
+the target in the simulated house for a search (:func:`hide_target`), and the
 episode itself (:func:`run_sim_episode` on the simulator, :func:`run_episode` on any robot): the
 follower of §II (perception, Algorithm 2, the belief of Eq. 4, the behavior tree of Fig. 2) ticked
 until the duration runs out, measured by :mod:`pfctl.core.metrics`.
@@ -53,7 +53,7 @@ def target_profile(
         except (OSError, ValueError) as err:
             raise UserError(f"--target {path}: {err}") from None
         return profile
-    from pfctl.commands.learn_target import learn_in_sim
+    from pfctl.app.learn_target import learn_in_sim
 
     with Progress(
         TextColumn("learning the target"),
@@ -67,16 +67,6 @@ def target_profile(
         return learn_profile(learned.appearances, params)
     except ValueError:
         raise UserError(f"{source}: the simulated target was never seen whole") from None
-
-
-def sim_robot(mission: Mission, seed: int | None, gui: bool, source: str) -> SimRobot:
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-    from pfctl.core.mapping.planning import NoPathError
-
-    try:
-        return SimRobot(mission, SimOptions(seed=seed, gui=gui, realtime=gui))
-    except NoPathError as err:
-        raise UserError(f"{source}: scenario.people: a route cannot be walked: {err}") from None
 
 
 class RecordingRobot:
@@ -205,14 +195,14 @@ def metric_params(mission: Mission) -> MetricParams:
     return MetricParams(band=(lo, hi))
 
 
-def hide_target(robot: SimRobot, region: str | None) -> str:
+def hide_target(mission: Mission, robot: SimRobot, region: str | None) -> str:
     """Put the scenario's target at a free spot of ``region`` (None: one of the mission's
     ``scenario.randomize.hide_in``, else a region other than the robot's and its neighbours,
-    chosen by the seed), standing still, out of the robot's view; the region used."""
+    chosen by the seed), standing still, out of the robot's view; the region used. ``robot``
+    simulates ``mission``."""
     from pfctl.backends.pybullet.walkers import PERSON_RADIUS
     from pfctl.core.mapping.regions import RegionMap
 
-    mission = robot.mission
     target = next((w for w in robot.people if w.is_target), None)
     if target is None:
         raise UserError("scenario.target: the mission names no target to search for")
@@ -246,6 +236,5 @@ __all__ = [
     "metric_params",
     "run_episode",
     "run_sim_episode",
-    "sim_robot",
     "target_profile",
 ]

@@ -149,9 +149,10 @@ def sim_dataset(
     mission: Mission, scans: int, seed: int, params: LegParams, progress: Progress = _nothing
 ) -> LegDataset:
     """Labelled segments of ``scans`` simulated scans (seeded) in the house of ``mission``."""
+    from pfctl.app.sim import house_config
     from pfctl.backends.pybullet.leg_scans import LegScanGenerator
 
-    generator = LegScanGenerator(mission)
+    generator = LegScanGenerator(house_config(mission))
     rng = np.random.default_rng(seed)
     data = LegDataset("sim")
     feats, labels = [], []

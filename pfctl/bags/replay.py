@@ -11,7 +11,7 @@
   image (``/pfctl/person_labels``, :mod:`pfctl.backends.hsr.person_labels`, as ``pfctl sim
   serve-hsr`` or a person detector on the robot publishes it) of the same stamp becomes the
   frame's ``mask``; without one, person keypoints (``/pfctl/person_keypoints``,
-  ``sensor_msgs/PointCloud``, :mod:`pfctl.backends.hsr.person_keypoints`) of the same stamp
+  ``sensor_msgs/PointCloud``, :mod:`pfctl.bags.person_keypoints`) of the same stamp
   become the frame's ``people``.
 
 :meth:`Replay.stream` then yields :class:`~pfctl.core.robot.LaserScan` and
@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from pfctl.backends.hsr.person_keypoints import people_from_cloud
+from pfctl.bags.person_keypoints import people_from_cloud
 from pfctl.bags.reading import LASER_SCAN, Bag, BagError, laser_scan, open_bag, stamp_seconds
 from pfctl.core.robot import CameraInfo, GivenPerson, LaserScan, Pose2D, RgbdFrame
 from pfctl.core.tf_buffer import TransformBuffer, TransformLookupError
@@ -56,7 +56,7 @@ KNOWN_CAMERAS = (
 SYNC_SLOP = 0.02
 #: Person labels (an instance/part image, :mod:`pfctl.backends.hsr.person_labels`) tried first.
 KNOWN_LABELS = ("/pfctl/person_labels",)
-#: Person keypoints (2-D keypoints/boxes, :mod:`pfctl.backends.hsr.person_keypoints`).
+#: Person keypoints (2-D keypoints/boxes, :mod:`pfctl.bags.person_keypoints`).
 KNOWN_KEYPOINTS = ("/pfctl/person_keypoints",)
 
 

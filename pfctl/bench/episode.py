@@ -123,7 +123,8 @@ def run_episode_task(spec: EpisodeSpec) -> dict[str, Any]:
 def _run(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[str, Any]]:
     from rich.console import Console
 
-    from pfctl.app.episodes import hide_target, run_sim_episode, sim_robot, target_profile
+    from pfctl.app.episodes import hide_target, run_sim_episode, target_profile
+    from pfctl.app.sim import sim_robot
     from pfctl.core.metrics import MetricParams, follow_metrics, search_metrics
 
     mission = spec.mission
@@ -132,11 +133,11 @@ def _run(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[str, Any]]:
     deadline = start + spec.timeout if spec.timeout > 0 else math.inf
     profile = target_profile(mission, None, spec.seed, Console(stderr=True, quiet=True), source)
     learn_s = time.perf_counter() - start
-    robot = sim_robot(mission, spec.seed, False, source)
+    robot = sim_robot(mission, spec.seed, source)
     region = None
     with robot:
         if spec.task == "search":
-            region = hide_target(robot, None)
+            region = hide_target(mission, robot, None)
         result = run_sim_episode(
             mission,
             robot,

@@ -47,11 +47,10 @@ from pfctl.app.episodes import (
     metric_params,
     run_episode,
     run_sim_episode,
-    sim_robot,
     target_profile,
 )
 from pfctl.app.follower import EpisodeResult
-from pfctl.commands.replay import tracks_csv
+from pfctl.app.tracks_file import tracks_csv
 from pfctl.core.metrics import (
     FollowMetrics,
     SearchMetrics,
@@ -61,11 +60,12 @@ from pfctl.core.metrics import (
 from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all
+from pfctl.files import atomic_write_all, check_episode_dir
 from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
 if TYPE_CHECKING:
+    from pfctl.backends.pybullet.simulation import SimRobot
     from pfctl.bags.recording import EpisodeRecorder
 
 BACKENDS = ("sim", "hsr")
@@ -174,7 +174,7 @@ def follow(
     if backend == "hsr":
         result, seed_used = _run_hsr(loaded, profile, duration, console, "following"), None
     else:
-        robot = sim_robot(loaded, seed, gui, str(mission))
+        robot = _sim_robot(loaded, seed, gui, str(mission))
         seed_used = robot.seed
         with robot, _worker_errors():
             recorder = _recorder(record, loaded)
@@ -210,6 +210,14 @@ def follow(
     _end(result)
 
 
+def _sim_robot(mission: Mission, seed: int | None, gui: bool, source: str) -> SimRobot:
+    """The simulated house; with ``gui`` in PyBullet's window, paced to the clock."""
+    from pfctl.app.sim import sim_robot
+    from pfctl.backends.pybullet.simulation import SimOptions
+
+    return sim_robot(mission, seed, source, SimOptions(gui=gui, realtime=gui))
+
+
 def _run_hsr(
     mission: Mission,
     profile: TargetProfile,
@@ -221,9 +229,10 @@ def _run_hsr(
 ) -> EpisodeResult:
     """The follower on the HSR over ROS 1 (``backend.hsr``) for ``duration`` s of ROS time; the
     simulator's truth is recorded for the metrics when ``pfctl sim serve-hsr`` publishes it."""
+    from pfctl.app.hsr import hsr_config
     from pfctl.backends.hsr.robot import HsrRobot
 
-    robot = HsrRobot(mission)
+    robot = HsrRobot(hsr_config(mission))
     with robot, _worker_errors():
         truth = robot.ground_truth if robot.ground_truth() is not None else None
         with graceful_interrupts() as stop, _progress(console, duration, "s") as bar:
@@ -260,9 +269,8 @@ def _recorder(record: Path | None, mission: Mission) -> EpisodeRecorder | None:
     if record is None:
         return None
     from pfctl.bags.recording import EpisodeRecorder, RecordingError
-    from pfctl.commands.sim import _check_episode_dir
 
-    _check_episode_dir(record)
+    check_episode_dir(record)
     try:
         return EpisodeRecorder(record, mission.name, images=False)
     except RecordingError as err:
@@ -360,10 +368,10 @@ def search(
     if backend == "hsr":
         result = _run_hsr(loaded, profile, duration, console, "searching", until_found=True)
     else:
-        robot = sim_robot(loaded, seed, gui, str(mission))
+        robot = _sim_robot(loaded, seed, gui, str(mission))
         seed_used = robot.seed
         with robot, _worker_errors():
-            hidden_in = hide_target(robot, region)
+            hidden_in = hide_target(loaded, robot, region)
             with graceful_interrupts() as stop, _progress(console, duration) as bar:
                 task = bar.add_task("searching", total=duration)
                 result = run_sim_episode(

@@ -14,7 +14,6 @@ half-written.
 
 from __future__ import annotations
 
-import csv
 import io
 import sys
 from pathlib import Path
@@ -26,6 +25,7 @@ from rich.console import Console
 
 from pfctl.app.perception import build_perception
 from pfctl.app.profiles import load_target_profile
+from pfctl.app.tracks_file import tracks_csv
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.bags.replay import Replay, open_replay
 from pfctl.core.episode import TrackRow
@@ -42,7 +42,6 @@ from pfctl.files import atomic_write_all
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 
-COLUMNS = ("t", "track_id", "x", "y", "vx", "vy", "confidence", "is_target")
 #: A track unseen for longer than this (s) is drawn with a gap.
 GAP_S = 0.5
 #: At most this many laser returns are drawn as the backdrop of tracks.png.
@@ -149,19 +148,6 @@ def _run(
     return rows, points, frames
 
 
-def tracks_csv(rows: list[TrackRow]) -> str:
-    """The rows as ``tracks.csv`` (:data:`COLUMNS`; mm and mm/s resolution)."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(COLUMNS)
-    for t, tid, x, y, vx, vy, conf, is_target in rows:
-        writer.writerow(
-            [f"{t:.3f}", tid, f"{x:.3f}", f"{y:.3f}", f"{vx:.3f}", f"{vy:.3f}", f"{conf:.3f}",
-             int(is_target)]
-        )  # fmt: skip
-    return buf.getvalue()
-
-
 def _plot(source: Replay, rows: list[TrackRow], points: np.ndarray, title: str) -> bytes:
     import matplotlib
 
@@ -209,4 +195,4 @@ def _plot(source: Replay, rows: list[TrackRow], points: np.ndarray, title: str) 
     return buf.getvalue()
 
 
-__all__ = ["COLUMNS", "replay", "tracks_csv"]
+__all__ = ["replay"]

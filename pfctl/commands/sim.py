@@ -30,9 +30,9 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
-from pfctl.core.mapping.planning import NoPathError
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
+from pfctl.files import check_episode_dir
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 from pfctl.mission.map_server import GridFileError, save_map_server
@@ -85,9 +85,10 @@ def run(
 ) -> None:
     """Run the simulated house: people walk their routes; the robot stands, replays a script or
     is driven from the keyboard. Writes a top-down PNG of everyone's paths."""
+    from pfctl.app.sim import sim_robot
     from pfctl.backends.pybullet import drivers
-    from pfctl.backends.pybullet.runner import graceful_interrupts, run_episode
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.backends.pybullet.runner import run_simulation
+    from pfctl.backends.pybullet.simulation import SimOptions
     from pfctl.bags.recording import Episode, EpisodeRecorder, RecordingError
     from pfctl.plots.sim_run import plot_paths
 
@@ -102,7 +103,7 @@ def run(
     if teleop and not gui and not sys.stdin.isatty():
         raise UserError("--teleop: stdin is not a terminal; run it in a terminal or with --gui")
     if record is not None:
-        _check_episode_dir(record)
+        check_episode_dir(record)
     if png is None:
         png = record / "paths.png" if record is not None else Path("sim_run.png")
     if png.suffix.lower() != ".png":
@@ -117,16 +118,12 @@ def run(
         except drivers.ScriptError as err:
             raise UserError(str(err)) from None
     options = SimOptions(
-        seed=seed,
         gui=gui,
         realtime=realtime or teleop,
         camera=camera,
         laser_model="bullet" if laser == "bullet" else "fast",
     )
-    try:
-        robot = SimRobot(loaded, options)
-    except NoPathError as err:
-        raise UserError(f"{mission}: scenario.people: a route cannot be walked: {err}") from None
+    robot = sim_robot(loaded, seed, str(mission), options)
     console = Console(stderr=True)
     with robot:
         driver: drivers.ScriptedDriver | drivers.KeyboardDriver | None = None
@@ -149,12 +146,12 @@ def run(
             with graceful_interrupts() as stop, _Progress(console, duration) as tick:
                 if teleop and not gui:
                     with drivers.TerminalKeys() as terminal:
-                        result = run_episode(
+                        result = run_simulation(
                             robot, duration, driver, recorder, terminal.read, tick, stop
                         )
                 else:
                     keys = (lambda: drivers.window_keys(robot.client)) if teleop else None
-                    result = run_episode(robot, duration, driver, recorder, keys, tick, stop)
+                    result = run_simulation(robot, duration, driver, recorder, keys, tick, stop)
             if recorder is not None:
                 recorder.close()
         except BaseException:
@@ -179,16 +176,6 @@ def run(
     _report(loaded, result, robot.collisions, picture, record)
     if result.interrupted:
         raise typer.Exit(130)
-
-
-def _check_episode_dir(path: Path) -> None:
-    """Refuse to write an episode over a file or over a folder that holds something else."""
-    if path.exists() and not path.is_dir():
-        raise UserError(f"--record {path}: exists and is not a directory")
-    if path.is_dir() and any(path.iterdir()) and not (path / "episode.json").is_file():
-        raise UserError(
-            f"--record {path}: a folder that is neither empty nor an episode; choose another"
-        )
 
 
 class _Progress:
@@ -401,31 +388,30 @@ def _serve(
     from pfctl.backends.hsr.sim_bridge import (
         CLOCK_OFFSET,
         SimHsrBridge,
-        check_master,
         claim_sim_time,
         master_uri,
+        reach_master,
     )
 
     import_rospy()  # ROS 1 missing: one line naming the apt packages
     uri = master_uri()
-    check_master(uri)
+    reach_master(uri)
     claim_sim_time(uri)  # before the simulator loads: a node reads /use_sim_time as it starts
-    from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
+    from pfctl.app.hsr import hsr_config
+    from pfctl.app.sim import sim_robot
 
-    try:
-        robot = SimRobot(mission, SimOptions(seed=seed))
-    except NoPathError as err:
-        raise UserError(f"{path}: scenario.people: a route cannot be walked: {err}") from None
+    robot = sim_robot(mission, seed, str(path))
     with robot:
         scene = None
         if hide is not None:
             from pfctl.app.episodes import hide_target
 
-            hide_target(robot, hide)
+            hide_target(mission, robot, hide)
         elif pose_target:
             scene = _posing(robot, str(path))
         bridge = SimHsrBridge(
             robot,
+            hsr_config(mission),
             uri,
             rate=rate,
             depth_encoding=depth_encoding,
@@ -470,7 +456,7 @@ def _serve(
 def _posing(robot: SimRobot, source: str) -> Callable[[float], None]:
     """Hold the target in front of the robot (as ``pfctl learn-target`` does in the simulator),
     turning a little from side to side; the scene callback that keeps them there."""
-    from pfctl.commands.learn_target import SWAY, stand_in_front
+    from pfctl.app.learn_target import SWAY, stand_in_front
 
     x, y, _ = stand_in_front(robot, source=source)
     target = next(w for w in robot.people if w.is_target)

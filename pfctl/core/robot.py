@@ -93,6 +93,19 @@ class HeadTarget:
 
 
 @dataclass(frozen=True)
+class RobotLimits:
+    """The robot's size and the limits every backend clamps its commands to (the mission's
+    ``robot`` section declares their defaults, units and meanings)."""
+
+    radius: float
+    max_linear_speed: float
+    max_angular_speed: float
+    head_pan_limits: tuple[float, float]
+    head_tilt_limits: tuple[float, float]
+    head_max_speed: float
+
+
+@dataclass(frozen=True)
 class LaserScan:
     """A planar scan like ``sensor_msgs/LaserScan`` (REP-117: ``inf`` = no return in range).
 

@@ -1,5 +1,5 @@
 """The reactive baseline against the paper's tree on the paper's episode (seed 1, §III-B): both
-follow Alice out of the kitchen and lose her at the office door (~9.9 s); the reactive baseline
+follow Alice out of the kitchen and lose her at the office door; the reactive baseline
 (``missions/baselines/house_reactive.yaml``) then stops and never searches, while the paper's
 tree (Fig. 2) goes to the prediction and searches. One target profile learned for both runs;
 15 s simulated each."""
@@ -13,9 +13,10 @@ import pytest
 from rich.progress import Progress
 
 from pfctl.app.episodes import LEARN_SECONDS, run_sim_episode
+from pfctl.app.learn_target import learn_in_sim
 from pfctl.app.perception import identity_params
-from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import learn_in_sim
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
 from pfctl.core.episode import TickRecord
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
@@ -39,7 +40,7 @@ def profile() -> TargetProfile:
 
 def _episode(path: Path, profile: TargetProfile) -> list[TickRecord]:
     mission = load_mission(path)
-    with SimRobot(mission, SimOptions(seed=SEED)) as robot:
+    with SimRobot(sim_config(mission, SEED)) as robot:
         result = run_sim_episode(mission, robot, profile, SECONDS)
     return result.log.ticks
 

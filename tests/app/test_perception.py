@@ -8,6 +8,7 @@ from pathlib import Path
 import pytest
 
 from pfctl.app.perception import build_perception
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.mission import loads_mission
 
@@ -24,7 +25,7 @@ def test_two_people_crossing_paths_keep_their_track_ids(seed: int) -> None:
     perception = build_perception(mission)
     owners: dict[str, set[int]] = {"ann": set(), "ben": set()}
     seen_crossing = False
-    with SimRobot(mission, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(mission), SimOptions(camera=False)) as robot:
         while robot.time < 7.0:
             robot.step()
             observation = robot.observe()

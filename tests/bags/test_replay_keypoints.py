@@ -1,5 +1,5 @@
 """``pfctl replay`` of a bag whose people come as person keypoints (``/pfctl/person_keypoints``,
-``sensor_msgs/PointCloud``, :mod:`pfctl.backends.hsr.person_keypoints`) and not as a label image:
+``sensor_msgs/PointCloud``, :mod:`pfctl.bags.person_keypoints`) and not as a label image:
 the frames carry the people, and the GivenPersonDetector places them by the depth (§II-E).
 
 The bag is written here with ``rosbags`` (no ROS needed): a laser looking back at nothing, a
@@ -18,7 +18,7 @@ import pytest
 from rosbags.rosbag1 import Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from pfctl.backends.hsr.person_keypoints import BOX_BOTTOM_RIGHT, BOX_TOP_LEFT, cloud_fields
+from pfctl.bags.person_keypoints import BOX_BOTTOM_RIGHT, BOX_TOP_LEFT, cloud_fields
 from pfctl.bags.replay import open_replay
 from pfctl.core.robot import RgbdFrame
 from pfctl.errors import UserError

@@ -15,7 +15,7 @@ import pytest
 pytestmark = [pytest.mark.sim, pytest.mark.slow]
 
 HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
-#: Re-identification must come within this long after the loss (seed 1 measures about 30 s).
+#: Re-identification must come within this long after the loss, seconds.
 REFIND_WITHIN_S = 45.0
 
 

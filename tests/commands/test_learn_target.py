@@ -11,10 +11,11 @@ import numpy as np
 import pytest
 from rich.progress import Progress
 
+from pfctl.app.learn_target import learn_from_images
 from pfctl.app.perception import identity_params
 from pfctl.app.profiles import load_target_profile
-from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import learn_from_images
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.core.perception.clothes import histogram_intersection
 from pfctl.core.perception.identity.profile import learn_profile
 from pfctl.core.perception.vision import MaskPersonDetector
@@ -71,7 +72,7 @@ def pictures(
     (root / "frames").mkdir()
     (root / "crops").mkdir()
     boxes: dict[str, list[tuple[tuple[int, int, int, int], float]]] = {}
-    with SimRobot(loads_mission(TWO, source="two.yaml"), SimOptions()) as robot:
+    with SimRobot(sim_config(loads_mission(TWO, source="two.yaml"))) as robot:
         detector = MaskPersonDetector(
             robot.person_instances(), names=robot.people_bodies.instance_names()
         )

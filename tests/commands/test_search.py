@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from pfctl.app.episodes import hide_target
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.mission import load_mission
 
@@ -37,13 +38,13 @@ def _near(points: np.ndarray, xy: tuple[float, float], radius: float) -> int:
 
 def test_the_hidden_target_is_gone_from_the_first_observation() -> None:
     mission = load_mission(HOUSE)
-    with SimRobot(mission, SimOptions(camera=False, seed=3)) as robot:
+    with SimRobot(sim_config(mission, 3), SimOptions(camera=False)) as robot:
         alice = next(w for w in robot.people if w.is_target)
         start = (alice.x, alice.y)
         before = robot.observe().scan
         assert before is not None and _near(before.points(), start, 0.3) > 0  # her legs
-    with SimRobot(mission, SimOptions(camera=False, seed=3)) as robot:
-        region = hide_target(robot, "bedroom")
+    with SimRobot(sim_config(mission, 3), SimOptions(camera=False)) as robot:
+        region = hide_target(mission, robot, "bedroom")
         after = robot.observe().scan
         alice = next(w for w in robot.people if w.is_target)
         assert region == "bedroom" and robot.ground_truth().stamp == 0.0

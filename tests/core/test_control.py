@@ -168,9 +168,11 @@ def test_gaze_pd_converges_without_overshoot_on_a_head_following_its_command(
 @pytest.mark.sim
 def test_gaze_pd_converges_on_the_simulated_head_servo() -> None:
     head_mod = pytest.importorskip("pfctl.backends.pybullet.head")
+    from pfctl.app.sections import from_section
+    from pfctl.core.robot import RobotLimits
     from pfctl.mission import RobotConfig
 
-    servo = head_mod.HeadServo(RobotConfig())
+    servo = head_mod.HeadServo(from_section(RobotLimits, RobotConfig()))
     ctl = GazeController(PARAMS)
     goal = HeadTarget(-3.0, -0.6)
     dt = 0.1

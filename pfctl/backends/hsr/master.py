@@ -3,6 +3,7 @@ is down or unreachable would hang a node in ``init_node``, or a watchdog in its 
 
 from __future__ import annotations
 
+import http.client
 import xmlrpc.client
 
 MASTER_TIMEOUT = 1.0
@@ -31,4 +32,26 @@ def master_proxy(uri: str, timeout: float = MASTER_TIMEOUT) -> xmlrpc.client.Ser
 MASTER_ERRORS = (OSError, xmlrpc.client.Error)
 """What a call through :func:`master_proxy` raises when the master does not answer properly."""
 
-__all__ = ["MASTER_ERRORS", "MASTER_TIMEOUT", "master_proxy"]
+
+class MasterError(Exception):
+    """The ROS master did not answer ``getPid``: ``error`` is what the call raised (no master
+    there), or None when the master answered with a failure, ``answer`` its message."""
+
+    def __init__(self, error: BaseException | None, answer: str = "") -> None:
+        super().__init__(str(error) if error is not None else answer)
+        self.error = error
+        self.answer = answer
+
+
+def check_master(uri: str, caller: str, timeout: float = MASTER_TIMEOUT) -> None:
+    """Raise :class:`MasterError` unless the ROS master at ``uri`` answers ``getPid`` (as
+    ``caller``) within ``timeout`` seconds: ``rospy.init_node`` would wait for it forever."""
+    try:
+        code, message, _ = master_proxy(uri, timeout).getPid(caller)
+    except (*MASTER_ERRORS, http.client.HTTPException, ValueError) as err:
+        raise MasterError(err) from None
+    if code != 1:
+        raise MasterError(None, str(message))
+
+
+__all__ = ["MASTER_ERRORS", "MASTER_TIMEOUT", "MasterError", "check_master", "master_proxy"]

@@ -1,14 +1,14 @@
 """The Toyota HSR over ROS 1: :class:`HsrRobot` implements the Robot port (``pfctl.core.robot``).
 
-One ROS node (rospy) per process. :class:`HsrRobot` subscribes to the topics of
-``backend.hsr`` (:class:`pfctl.mission.HsrConfig`), looks poses up in tf, publishes the base and
-head commands, and drives ``move_base`` through actionlib:
+One ROS node (rospy) per process. :class:`HsrRobot` subscribes to the topics of its
+:class:`~pfctl.backends.hsr.config.HsrConfig` (the mission's ``backend.hsr``), looks poses up in
+tf, publishes the base and head commands, and drives ``move_base`` through actionlib:
 
 * **observe** — the newest laser scan since the previous observation, posed by tf
   ``map → <scan frame>`` at the scan's stamp; the newest complete RGB-D frame (RGB, depth,
   camera info and, when configured, the person labels or the person keypoints of one stamp,
   paired within :data:`CAMERA_SLOP`; the keypoints become the frame's ``people``,
-  :mod:`pfctl.backends.hsr.person_keypoints`), the camera's optical frame from tf
+  :mod:`pfctl.bags.person_keypoints`), the camera's optical frame from tf
   ``map → <image frame>`` at the image's stamp; the base pose (tf ``map → base`` or the
   ``pose`` topic); the head from the joint states; the odometry; the collision count from the
   simulator's truth (0 without it). When tf has no ``map → odom`` at a stamp yet, the odom
@@ -18,9 +18,9 @@ head commands, and drives ``move_base`` through actionlib:
 * **time** — every stamp the follower sees is seconds of ROS time since the robot was opened (the
   episode clock): sim seconds when the master's ``/use_sim_time`` is true and ``/clock`` runs
   (``pfctl sim serve-hsr``), wall seconds on a real robot.
-* **step** — waits until the next multiple of the control period ``1 / behavior.tick_hz`` on that
+* **step** — waits until the next multiple of the control period ``tick_period`` on that
   clock (a tick that overran waits for the next slot, it does not pile up).
-* **safety** — velocities are always clamped to ``robot``'s limits. A watchdog thread (wall clock,
+* **safety** — velocities are always clamped to ``limits``. A watchdog thread (wall clock,
   :data:`WATCHDOG_HZ`) publishes zero velocity as soon as the newest laser scan, pose or (sim
   time) ``/clock`` is older than ``stale_timeout`` (wall seconds since it was *received*: sim time
   freezes when the simulator dies; judged from the first command on, since a simulator may hold
@@ -51,10 +51,11 @@ from dataclasses import replace
 from typing import Any
 
 from pfctl.backends.hsr import convert
-from pfctl.backends.hsr.master import MASTER_ERRORS, master_proxy
-from pfctl.backends.hsr.person_keypoints import people_from_cloud
+from pfctl.backends.hsr.config import HsrConfig
+from pfctl.backends.hsr.master import MASTER_ERRORS, MasterError, check_master, master_proxy
 from pfctl.backends.hsr.person_labels import label_detector
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
+from pfctl.bags.person_keypoints import people_from_cloud
 from pfctl.bags.replay import image_labels
 from pfctl.core.perception.vision import GivenPersonDetector, MaskPersonDetector
 from pfctl.core.robot import (
@@ -74,8 +75,9 @@ from pfctl.core.robot import (
 )
 from pfctl.core.tf_buffer import quaternion_matrix
 from pfctl.errors import UserError
-from pfctl.mission import HsrConfig, Mission
 
+MASTER_CHECK_TIMEOUT = 2.0
+"""Wall seconds the ROS master may take to answer at start."""
 CAMERA_SLOP = 0.02
 """Seconds by which the stamps of one RGB-D frame's images may differ (serve-hsr: 0)."""
 TF_WAIT = 0.25
@@ -104,18 +106,18 @@ class RobotDataError(UserError):
 # ------------------------------------------------------------------------------------- helpers
 
 
-def check_master(uri: str, timeout: float = 2.0) -> None:
+def _connect_master(uri: str) -> None:
     """Raise :class:`RobotConnectionError` unless the ROS master at ``uri`` answers within
-    ``timeout`` seconds (rospy would block forever in ``init_node``)."""
+    :data:`MASTER_CHECK_TIMEOUT` seconds (rospy would block forever in ``init_node``)."""
     try:
-        code, message, _ = master_proxy(uri, timeout).getPid("/pfctl_check")
-    except MASTER_ERRORS as err:
+        check_master(uri, "/pfctl_check", MASTER_CHECK_TIMEOUT)
+    except MasterError as err:
+        if err.error is None:
+            raise RobotConnectionError(f"the ROS master at {uri} answered: {err.answer}") from None
         raise RobotConnectionError(
-            f"cannot reach the ROS master at {uri} ({err}): start roscore, or point "
+            f"cannot reach the ROS master at {uri} ({err.error}): start roscore, or point "
             "ROS_MASTER_URI at the robot's master"
         ) from None
-    if code != 1:
-        raise RobotConnectionError(f"the ROS master at {uri} answered: {message}")
 
 
 def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
@@ -123,8 +125,8 @@ def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
     (:func:`pfctl.bags.recording.person_marker`: ``ns`` = name, pose = position and
     heading, ``text`` = ``"target speed=0.800"``); markers that are not ADD are skipped.
 
-    The decoder is the simulator's (imported here, not at module level: a real robot publishes
-    no truth and its process never loads the PyBullet backend)."""
+    The decoder is the episode recorder's (imported here, not at module level: a real robot
+    publishes no truth, and the bag writer beside the decoder loads slowly)."""
     from pfctl.bags.recording import person_from_marker
 
     return tuple(
@@ -136,7 +138,7 @@ def people_from_markers(msg: Any) -> tuple[PersonTruth, ...]:
 
 def frame_people(msg: Any, topic: str, shape: tuple[int, int]) -> tuple[GivenPerson, ...]:
     """The people of a person-keypoints message (``sensor_msgs/PointCloud``,
-    :mod:`pfctl.backends.hsr.person_keypoints`) for an image of ``shape``;
+    :mod:`pfctl.bags.person_keypoints`) for an image of ``shape``;
     :class:`RobotDataError` naming ``topic`` and what was expected when it is malformed."""
     try:
         return people_from_cloud(msg, shape)
@@ -176,8 +178,8 @@ def _ensure_node(rospy: Any, node_name: str) -> str:
 class HsrRobot:
     """The Toyota HSR (or ``pfctl sim serve-hsr``) over ROS 1; implements the Robot port.
 
-    ``HsrRobot(mission)`` connects: it checks the master, starts the node, subscribes, and waits
-    (wall clock, ``backend.hsr.connect_timeout`` unless ``connect_timeout`` is given) for the
+    ``HsrRobot(config)`` connects: it checks the master, starts the node, subscribes, and waits
+    (wall clock, ``config.connect_timeout`` unless ``connect_timeout`` is given) for the
     first laser scan and its tf, the pose, the head's joint states, a subscriber of the base
     command and, under sim time, ``/clock``; then, when their publishers exist, for the
     ``move_base`` action server and the simulator's truth. Use it as a context manager, or call
@@ -185,11 +187,10 @@ class HsrRobot:
     """
 
     def __init__(
-        self, mission: Mission, *, node_name: str = "pfctl", connect_timeout: float | None = None
+        self, config: HsrConfig, *, node_name: str = "pfctl", connect_timeout: float | None = None
     ) -> None:
-        self.mission = mission
-        self.config: HsrConfig = mission.backend.hsr
-        self.period = 1.0 / mission.behavior.tick_hz
+        self.config = config
+        self.period = config.tick_period
         """The control period (s of ROS time)."""
         timeout = self.config.connect_timeout if connect_timeout is None else connect_timeout
         if not (math.isfinite(timeout) and timeout > 0):
@@ -228,7 +229,7 @@ class HsrRobot:
         rosgraph = import_ros_module("rosgraph")
         self.master_uri = str(rosgraph.get_master_uri())
         """The ROS master this robot talks to (``ROS_MASTER_URI``)."""
-        check_master(self.master_uri)
+        _connect_master(self.master_uri)
         self.node = _ensure_node(rospy, node_name)
         """This process's node name."""
         self.use_sim_time = not rospy.rostime.is_wallclock()
@@ -732,7 +733,7 @@ class HsrRobot:
 
     def clamp(self, t: Twist2D) -> Twist2D:
         """The command within the mission's linear (vx, vy norm) and angular limits."""
-        rc = self.mission.robot
+        rc = self.config.limits
         vx, vy, wz = (v if math.isfinite(v) else 0.0 for v in (t.vx, t.vy, t.wz))
         n = math.hypot(vx, vy)
         k = min(1.0, rc.max_linear_speed / n) if n > 0 else 1.0
@@ -762,12 +763,12 @@ class HsrRobot:
 
     def point_head(self, head: HeadTarget) -> None:
         """Send the head toward ``head`` (clamped to the joint limits) in the time the head
-        needs at ``robot.head_max_speed``, at least one control period."""
+        needs at ``limits.head_max_speed``, at least one control period."""
         self._start_clock()
         if self._closed or self._lost is not None:
             return
         self._arm()
-        rc = self.mission.robot
+        rc = self.config.limits
         pan = min(max(head.pan, rc.head_pan_limits[0]), rc.head_pan_limits[1])
         tilt = min(max(head.tilt, rc.head_tilt_limits[0]), rc.head_tilt_limits[1])
         now = self._head or HeadState()
@@ -1033,7 +1034,7 @@ class HsrRobot:
             return GivenPersonDetector()
         if self.config.person_labels is None:
             return None
-        return label_detector(self.mission.perception.vision.min_pixels)
+        return label_detector(self.config.min_pixels)
 
     def close(self) -> None:
         """Cancel the goal, publish zero velocity (delivered before the topics are released),
@@ -1074,7 +1075,6 @@ __all__ = [
     "HsrRobot",
     "RobotConnectionError",
     "RobotDataError",
-    "check_master",
     "frame_people",
     "people_from_markers",
 ]

@@ -1,8 +1,9 @@
 """The simulated house served as a Toyota HSR on a ROS 1 master (``pfctl sim serve-hsr``).
 
 :class:`SimHsrBridge` runs a :class:`~pfctl.backends.pybullet.simulation.SimRobot` and serves the
-interfaces of the mission's ``backend.hsr`` section with the message types, frames and stamps of
-Toyota's ROS 1 stack, so that :mod:`pfctl.backends.hsr.robot` cannot tell it from the robot.
+interfaces of an :class:`~pfctl.backends.hsr.config.HsrConfig` (the mission's ``backend.hsr``)
+with the message types, frames and stamps of Toyota's ROS 1 stack, so that
+:mod:`pfctl.backends.hsr.robot` cannot tell it from the robot.
 
 Time
     The master's ``/use_sim_time`` is set to true before the node exists, and ``/clock``
@@ -33,7 +34,7 @@ What is published when
        ``image_rect_raw``, or 32FC1 m), ``camera_info`` and ``person_labels`` (16UC1, see
        :mod:`pfctl.backends.hsr.person_labels`: the simulator's stand-in for OpenPose) or, when
        the mission sets it, ``person_keypoints`` (``sensor_msgs/PointCloud``, see
-       :mod:`pfctl.backends.hsr.person_keypoints`: the mask detector's people — box, head,
+       :mod:`pfctl.bags.person_keypoints`: the mask detector's people — box, head,
        neck, mid-hip, ankles — as BODY_25 keypoints and box corners, standing in for OpenPose
        too), all with the same stamp and frame ``head_rgbd_sensor_rgb_frame``;
     6. once per control period (and at ``t`` = 0): the truth for metrics, never for the follower:
@@ -74,7 +75,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import http.client
 import math
 import os
 import queue
@@ -89,11 +89,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from pfctl.backends.hsr import convert
-from pfctl.backends.hsr.master import master_proxy
-from pfctl.backends.hsr.person_keypoints import cloud_message, detection_parts
+from pfctl.backends.hsr.config import HsrConfig
+from pfctl.backends.hsr.master import MasterError, check_master, master_proxy
 from pfctl.backends.hsr.person_labels import ENCODING as LABEL_ENCODING
 from pfctl.backends.hsr.person_labels import encode_labels
 from pfctl.backends.hsr.ros_import import import_ros_module, import_rospy
+from pfctl.bags.person_keypoints import cloud_message, detection_parts
 from pfctl.bags.recording import (
     CAMERA_FRAME,
     LASER_FRAME,
@@ -111,9 +112,9 @@ from pfctl.core.robot import (
     Twist2D,
 )
 from pfctl.errors import UserError
-from pfctl.mission import Mission
 
 if TYPE_CHECKING:
+    from pfctl.backends.pybullet.config import LaserConfig
     from pfctl.backends.pybullet.simulation import SimRobot
 
 CLOCK_OFFSET = 100.0
@@ -125,7 +126,7 @@ end)."""
 OFFSET_PARAM = "/pfctl/sim/clock_offset"
 SEED_PARAM = "/pfctl/sim/seed"
 DEPTH_ENCODINGS = ("16UC1", "32FC1")
-MASTER_TIMEOUT = 3.0
+MASTER_CHECK_TIMEOUT = 3.0
 """Wall seconds the master may take to answer before it counts as missing."""
 PEER_WAIT = 3.0
 """Wall seconds to wait for subscribers (and publishers) the master already knows to connect."""
@@ -165,18 +166,20 @@ def master_uri() -> str:
     return uri
 
 
-def check_master(uri: str, timeout: float = MASTER_TIMEOUT) -> None:
-    """A UserError (one line) unless a ROS master answers at ``uri`` within ``timeout`` seconds
-    (``rospy.init_node`` would wait for it forever)."""
+def reach_master(uri: str) -> None:
+    """A UserError (one line) unless a ROS master answers at ``uri`` within
+    :data:`MASTER_CHECK_TIMEOUT` seconds (``rospy.init_node`` would wait for it forever)."""
     try:
-        code, message, _ = master_proxy(uri, timeout).getPid("/" + NODE_NAME)
-    except (OSError, xmlrpc.client.Error, http.client.HTTPException, ValueError) as err:
-        reason = getattr(err, "strerror", None) or str(err) or type(err).__name__
+        check_master(uri, "/" + NODE_NAME, MASTER_CHECK_TIMEOUT)
+    except MasterError as err:
+        if err.error is None:
+            raise UserError(
+                f"the ROS master at {uri} does not answer getPid: {err.answer}"
+            ) from None
+        reason = getattr(err.error, "strerror", None) or str(err.error) or type(err.error).__name__
         raise UserError(
             f"no ROS master at {uri} ({reason}); start roscore or set ROS_MASTER_URI"
         ) from None
-    if code != 1:
-        raise UserError(f"the ROS master at {uri} does not answer getPid: {message}")
 
 
 def claim_sim_time(uri: str) -> None:
@@ -194,13 +197,15 @@ def claim_sim_time(uri: str) -> None:
 class HsrMessages:
     """The messages of the bridge, built from the simulator's values (no node needed)."""
 
-    def __init__(self, mission: Mission, depth_encoding: str = "16UC1") -> None:
+    def __init__(
+        self, config: HsrConfig, laser: LaserConfig, depth_encoding: str = "16UC1"
+    ) -> None:
         if depth_encoding not in DEPTH_ENCODINGS:
             raise ValueError(
                 f"unsupported depth encoding {depth_encoding!r} (expected 16UC1 or 32FC1)"
             )
-        self.mission = mission
-        self.cfg = mission.backend.hsr
+        self.cfg = config
+        self.laser = laser
         self.depth_encoding = depth_encoding
         self.geometry = _msgs("geometry_msgs.msg")
         self.std = _msgs("std_msgs.msg")
@@ -246,7 +251,7 @@ class HsrMessages:
 
     def tf_static(self) -> Any:
         """``/tf_static``: ``base_footprint → base_range_sensor_link`` (the laser's mount)."""
-        laser = self.mission.sensors.laser
+        laser = self.laser
         mount = self._planar(
             0.0, self.cfg.base_frame, LASER_FRAME, Pose2D(laser.mount_x, 0.0), laser.mount_height
         )
@@ -334,7 +339,7 @@ class HsrMessages:
 
     def person_keypoints(self, frame: RgbdFrame, people: list[PersonDetection]) -> Any:
         """``sensor_msgs/PointCloud`` of the mask detector's ``people`` in ``frame``
-        (:func:`~pfctl.backends.hsr.person_keypoints.detection_parts`, person = the simulator's
+        (:func:`~pfctl.bags.person_keypoints.detection_parts`, person = the simulator's
         instance index), with the frame's stamp and the camera's optical frame."""
         parts = {
             int(d.instance if d.instance is not None else i): detection_parts(d)
@@ -419,7 +424,8 @@ class BridgeStats:
 
 
 class SimHsrBridge:
-    """Serve ``robot`` (a fresh :class:`SimRobot`) as an HSR on the master at ``uri``.
+    """Serve ``robot`` (a fresh :class:`SimRobot`) as the HSR of ``config`` on the master at
+    ``uri``.
 
     :meth:`start` sets ``/use_sim_time``, starts the node and its topics, services and action
     server and waits for known peers; :meth:`run` steps and publishes (module docstring);
@@ -437,6 +443,7 @@ class SimHsrBridge:
     def __init__(
         self,
         robot: SimRobot,
+        config: HsrConfig,
         uri: str,
         *,
         rate: float = 1.0,
@@ -447,13 +454,12 @@ class SimHsrBridge:
         if not (math.isfinite(rate) and rate >= 0):
             raise ValueError(f"rate must be >= 0, got {rate}")
         self.robot = robot
-        self.mission = robot.mission
-        self.cfg = robot.mission.backend.hsr
+        self.cfg = config
         self.uri = uri
         self.rate = float(rate)
         self.node_name = node_name
         self.wait_for_command = wait_for_command
-        self.messages = HsrMessages(robot.mission, depth_encoding)
+        self.messages = HsrMessages(config, robot.config.laser, depth_encoding)
         self.stats = BridgeStats()
         self._events: queue.SimpleQueue[tuple[str, Any]] = queue.SimpleQueue()
         self._lock = threading.Lock()
@@ -468,7 +474,7 @@ class SimHsrBridge:
         self._instances = robot.person_instances()
         self._parts = robot.people_bodies.parts()
         self._keypoint_detector = MaskPersonDetector(
-            self._instances, self._parts, min_pixels=robot.mission.perception.vision.min_pixels
+            self._instances, self._parts, min_pixels=config.min_pixels
         )
 
     # -- start and stop ------------------------------------------------------------------------
@@ -751,7 +757,7 @@ class SimHsrBridge:
         self._publish(first, period_end=True)
         if on_ready is not None:
             on_ready()
-        laser_every = max(1, round(1.0 / (robot.substep * robot.mission.sensors.laser.rate_hz)))
+        laser_every = max(1, round(1.0 / (robot.substep * robot.config.laser.rate_hz)))
         try:
             while True:
                 if stop is not None and stop():
@@ -805,7 +811,7 @@ class SimHsrBridge:
         ``laser_every`` sub-steps, its camera frame at the camera's rate."""
         robot = self.robot
         t = k * robot.substep
-        period = 1.0 / robot.mission.sensors.camera.rate_hz
+        period = 1.0 / robot.config.camera.rate_hz
         frame_due = math.floor(t / period + 1e-9) > math.floor((t - robot.substep) / period + 1e-9)
         return replace(
             first,
@@ -846,9 +852,9 @@ __all__ = [
     "BridgeStats",
     "HsrMessages",
     "SimHsrBridge",
-    "check_master",
     "claim_sim_time",
     "master_proxy",
     "master_uri",
+    "reach_master",
     "ros_time",
 ]

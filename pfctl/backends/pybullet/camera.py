@@ -25,8 +25,8 @@ import math
 import numpy as np
 import pybullet as p
 
+from pfctl.backends.pybullet.config import CameraConfig
 from pfctl.core.robot import CameraInfo, HeadState, Pose2D, RgbdFrame
-from pfctl.mission import CameraConfig
 
 #: Clipping planes of the renderer, metres (the depth window is applied afterwards).
 NEAR_PLANE = 0.05

@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import math
 
-from pfctl.core.robot import HeadState, HeadTarget
-from pfctl.mission import RobotConfig
+from pfctl.core.robot import HeadState, HeadTarget, RobotLimits
 
 #: Proportional gain, 1/s² (a ~0.6 s settling time for a small step).
 KP = 40.0
@@ -24,7 +23,7 @@ MAX_DT = 0.005
 class HeadServo:
     """Pan/tilt joint state and its PD controller; :meth:`update` advances it by ``dt``."""
 
-    def __init__(self, robot: RobotConfig) -> None:
+    def __init__(self, robot: RobotLimits) -> None:
         self.limits = (tuple(robot.head_pan_limits), tuple(robot.head_tilt_limits))
         self.max_speed = float(robot.head_max_speed)
         self.angles = [0.0, 0.0]

@@ -6,8 +6,8 @@ Two models behind one interface, ``scan(pose, legs, stamp) -> LaserScan``:
   not move, so each beam is intersected with their outline segments in one matrix product, and
   with every leg circle ``[x, y, radius]`` analytically. Outlines of solid boxes are one-sided
   (a beam from outside meets a box's front faces first, so its back faces are dropped before the
-  product), and the static ranges are reused while the laser does not move. About 0.3 ms a scan
-  in the house, against 3–5 ms for ``rayTestBatch``.
+  product), and the static ranges are reused while the laser does not move (``bench_sim.py``
+  compares it with ``rayTestBatch``).
 - :class:`BulletLaser` casts the same beams with PyBullet's ``rayTestBatch`` at the laser's mount
   height against every body in the world (walls, furniture, the people's leg cylinders). It is the
   reference the fast model is tested against, and the model to use when bodies other than legs
@@ -25,8 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
+from pfctl.backends.pybullet.config import LaserConfig
 from pfctl.core.robot import LaserScan, Pose2D
-from pfctl.mission import LaserConfig
 
 
 @dataclass(frozen=True)
@@ -44,7 +44,7 @@ class LaserSpec:
 
     @classmethod
     def from_config(cls, cfg: LaserConfig) -> LaserSpec:
-        """The spec of a mission's ``sensors.laser`` (field of view centred ahead)."""
+        """The spec of the simulated laser (field of view centred ahead)."""
         beams = math.floor(cfg.fov_deg / cfg.resolution_deg + 1e-9) + 1
         if cfg.fov_deg >= 360.0:
             beams -= 1  # a full circle: the last beam would repeat the first

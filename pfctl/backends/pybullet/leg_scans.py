@@ -1,6 +1,6 @@
 """Labelled simulated laser scans for training and testing the leg detector (§II-E).
 
-Each scan puts the laser at a random free spot of a random room of the mission's house (walls
+Each scan puts the laser at a random free spot of a random room of the house (walls
 and furniture from :func:`~pfctl.backends.pybullet.world.build_world`), adds random furniture
 around it (boxes, bins, and tables and chairs whose thin legs are the classic false positives
 of a leg detector), places a crowd of 0–8 people 0.5–6 m from the laser (standing, legs side by
@@ -32,11 +32,11 @@ import pybullet as p
 import shapely
 from shapely.geometry.polygon import orient
 
+from pfctl.backends.pybullet.config import Clothes, HouseConfig
 from pfctl.backends.pybullet.laser import FastLaser, LaserSpec
-from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker, WalkerClothes
+from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker
 from pfctl.backends.pybullet.world import build_world, ccw_ring, outline
 from pfctl.core.robot import LaserScan, Pose2D
-from pfctl.mission import Mission
 
 
 @dataclass(frozen=True)
@@ -87,16 +87,16 @@ def _box(cx: float, cy: float, w: float, d: float, yaw: float) -> shapely.Polygo
 
 
 class LegScanGenerator:
-    """Draws labelled scans in the house of ``mission``; :meth:`draw` takes a seeded rng."""
+    """Draws labelled scans in ``house``; :meth:`draw` takes a seeded rng."""
 
-    def __init__(self, mission: Mission) -> None:
+    def __init__(self, house: HouseConfig) -> None:
         client = p.connect(p.DIRECT)
         try:
-            world = build_world(client, mission)
+            world = build_world(client, house)
         finally:
             p.disconnect(client)
         self.segments = world.scene.segments
-        layout = mission.layout()
+        layout = house.layout
         rooms = [shapely.Polygon(r.polygon) for r in layout.regions]
         furniture = shapely.union_all([shapely.Polygon(o.polygon) for o in layout.obstacles])
         walls = shapely.union_all([shapely.LineString([s[:2], s[2:]]) for s in self.segments])
@@ -198,7 +198,7 @@ class LegScanGenerator:
                 [pt],
                 cast(Any, None),  # one stop: no route to plan
                 speed=1.0,
-                clothes=WalkerClothes((0, 0, 0), (0, 0, 0)),
+                clothes=Clothes((0, 0, 0), (0, 0, 0)),
             )
             walker.theta = float(rng.uniform(-math.pi, math.pi))
             if rng.random() < 0.45:  # standing: legs together, or weight shifted
@@ -244,9 +244,9 @@ def _scan(
     )
 
 
-def simulate_leg_scans(mission: Mission, count: int, seed: int) -> Iterator[LabelledScan]:
-    """``count`` labelled scans in the house of ``mission``, deterministic for ``seed``."""
-    generator = LegScanGenerator(mission)
+def simulate_leg_scans(house: HouseConfig, count: int, seed: int) -> Iterator[LabelledScan]:
+    """``count`` labelled scans in ``house``, deterministic for ``seed``."""
+    generator = LegScanGenerator(house)
     rng = np.random.default_rng(seed)
     for _ in range(count):
         yield generator.draw(rng)

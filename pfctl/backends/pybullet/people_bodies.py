@@ -7,13 +7,9 @@ in the same clothes look the same), and a head box whose front carries a real fa
 face detector and embeddings (Algorithm 2) work on rendered frames. The faces come from
 scikit-image's subset of Labeled Faces in the Wild (``skimage.data.lfw_subset()``, 25x25 grey
 crops; Huang et al. 2007): each person wears a distinct one of :data:`LFW_FACES`, in a seeded
-order, tinted with a seeded skin tone (:func:`face_texture`). Measured on renders of three people
-at 1.2-2.5 m, facing the camera or turned by up to 20°, three seeds (faces searched in the
-head's mask region scaled to 100 px wide, :class:`pfctl.core.perception.faces.FaceEncoder`): at
-640x480 every face was found (63/63), the same person's embeddings stayed within 0.45 of each other
-and different people were at least 0.65 apart; at the house's 320x240, 62/63 were found, the same
-person within 0.54, different people at least 0.55 apart (so a single frame can mislead; the
-identifier decides on the median over a track's faces). Static bodies never touch each other, so
+order, tinted with a seeded skin tone (:func:`face_texture`); how well dlib finds and tells
+them apart on renders is in ``benchmarks/README.md`` (``bench_identity.py``). Static bodies never
+touch each other, so
 people do not collide among themselves; they are solid for the robot, the laser
 (``rayTestBatch``) and the camera (``getCameraImage`` and its segmentation mask).
 """

@@ -1,11 +1,12 @@
 """Running the simulated house for a while: step, drive, record, keep the truth (``pfctl sim run``).
 
-:func:`run_episode` steps a :class:`SimRobot` for ``duration`` simulated seconds. Each control
+:func:`run_simulation` steps a :class:`SimRobot` for ``duration`` simulated seconds. Each control
 period it asks the driver (a script, the keyboard, or none: the robot stands still) for a
 command, steps the simulator, hands the observation and the ground truth to the recorder, and
-keeps the truth for the picture. Inside :func:`graceful_interrupts`, Ctrl-C ends the run between
-two periods: the result says ``interrupted`` and what was recorded so far is a complete episode
-(a second Ctrl-C interrupts at once). The base is stopped at the end whatever happens.
+keeps the truth for the picture. Inside :func:`pfctl.interrupts.graceful_interrupts`, Ctrl-C ends
+the run between two periods: the result says ``interrupted`` and what was recorded so far is a
+complete episode (a second Ctrl-C interrupts at once). The base is stopped at the end whatever
+happens.
 """
 
 from __future__ import annotations
@@ -19,7 +20,6 @@ from pfctl.backends.pybullet.drivers import KeyboardDriver, ScriptStep
 from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.bags.recording import EpisodeRecorder
 from pfctl.core.robot import STOP, GroundTruth
-from pfctl.interrupts import StopFlag, graceful_interrupts
 
 
 class Driver(Protocol):
@@ -47,7 +47,7 @@ class RunResult:
         return self.sim_time / self.wall_time if self.wall_time > 0 else float("inf")
 
 
-def run_episode(
+def run_simulation(
     robot: SimRobot,
     duration: float,
     driver: Driver | None = None,
@@ -60,7 +60,8 @@ def run_episode(
 
     ``keys`` returns the keys pressed since its last call; they go to ``driver`` when it is a
     :class:`KeyboardDriver`. ``on_tick`` gets the simulated time after every period (progress).
-    ``stop`` (e.g. the flag of :func:`graceful_interrupts`) ends the run when it returns True.
+    ``stop`` (e.g. the flag of :func:`pfctl.interrupts.graceful_interrupts`) ends the run when it
+    returns True.
     """
     result = RunResult()
     start = time.perf_counter()
@@ -96,4 +97,4 @@ def run_episode(
     return result
 
 
-__all__ = ["Driver", "RunResult", "StopFlag", "graceful_interrupts", "run_episode"]
+__all__ = ["Driver", "RunResult", "run_simulation"]

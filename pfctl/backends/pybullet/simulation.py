@@ -1,33 +1,34 @@
 """SimRobot: the simulated house behind the Robot port (``pfctl.core.robot.Robot``).
 
-One :meth:`SimRobot.step` advances one control period (``1 / behavior.tick_hz``) in sub-steps
-no longer than the laser's period. In each sub-step
+A :class:`~pfctl.backends.pybullet.config.SimConfig` says what to simulate. One
+:meth:`SimRobot.step` advances one control period (``tick_period``) in sub-steps no longer than
+the laser's period. In each sub-step
 
 1. MOVE_BASE (:class:`~pfctl.backends.pybullet.navigation.Navigator`) turns an active goal into a
    velocity command, using the newest scan to see blockers; a goal given by :meth:`SimRobot.
    navigate` since the last step is planned here, in the first sub-step (``navigate`` itself only
    takes the goal: ACTIVE, or ABORTED at once when the goal is not free; a goal that cannot be
    reached is ABORTED by the next step);
-2. the omnidirectional base moves kinematically with the command, clamped to the mission's limits
+2. the omnidirectional base moves kinematically with the command, clamped to the robot's limits
    (``robot.max_linear_speed`` on the norm of (vx, vy), ``robot.max_angular_speed``); a move
    that would bring the base disc (``robot.radius``) into a wall, a piece of furniture or a
    person is refused, and each new contact counts one collision;
 3. the head's PD controller (:class:`~pfctl.backends.pybullet.head.HeadServo`) moves pan and tilt;
 4. the people walk their routes (:mod:`~pfctl.backends.pybullet.walkers`), waiting when the robot
    stands in their way;
-5. sensors that are due fire at their own rates (``sensors.laser.rate_hz``,
-   ``sensors.camera.rate_hz``): the laser (:class:`FastLaser`, or ``rayTestBatch`` with
-   ``laser_model="bullet"``) and the RGB-D camera (``getCameraImage``); the PyBullet bodies of
-   the people and the robot are placed before anything is rendered or ray cast.
+5. sensors that are due fire at their own rates (``laser.rate_hz``, ``camera.rate_hz``): the
+   laser (:class:`FastLaser`, or ``rayTestBatch`` with ``laser_model="bullet"``) and the RGB-D
+   camera (``getCameraImage``); the PyBullet bodies of the people and the robot are placed
+   before anything is rendered or ray cast.
 
 :meth:`SimRobot.observe` hands out the newest scan and frame (each once), the head angles, the
 collision count, the map-frame pose as localisation reports it (the true pose plus an error that
-wanders slowly, std ``sensors.pose.localization_*``; each scan's pose is the laser's pose as the
+wanders slowly, std ``pose_noise.localization_*``; each scan's pose is the laser's pose as the
 robot believes it, so the scan lands in the map as it would on the real robot) and the odometry
-(integrated from the motion with ``sensors.pose.odometry_*`` noise, so it drifts; its frame
+(integrated from the motion with ``pose_noise.odometry_*`` noise, so it drifts; its frame
 starts at the start pose).
 :meth:`SimRobot.ground_truth` is kept apart for metrics and recording. MOVE_BASE itself plans
-with the true pose. Everything random is drawn from the seed, so the same mission and seed give
+with the true pose. Everything random is drawn from the config's seed, so the same config gives
 the same episode; ``gui`` opens PyBullet's window and ``realtime`` paces the steps to the clock.
 """
 
@@ -42,6 +43,7 @@ import numpy as np
 import pybullet as p
 
 from pfctl.backends.pybullet.camera import SimCamera, camera_pose
+from pfctl.backends.pybullet.config import SimConfig
 from pfctl.backends.pybullet.head import HeadServo
 from pfctl.backends.pybullet.laser import BulletLaser, FastLaser, LaserSpec
 from pfctl.backends.pybullet.navigation import Navigator
@@ -63,7 +65,6 @@ from pfctl.core.robot import (
     Twist2D,
     wrap_angle,
 )
-from pfctl.mission import Mission
 
 #: Radius of a person's body for contacts with the robot, metres (the torso's half width).
 PERSON_CONTACT_RADIUS = 0.2
@@ -77,10 +78,8 @@ MIN_SUBSTEP_HZ = 20.0
 
 @dataclass(frozen=True)
 class SimOptions:
-    """How to run the simulator (the mission says what to simulate)."""
+    """How to run the simulator (:class:`SimConfig` says what to simulate)."""
 
-    seed: int | None = None
-    """Seed of everything random; None: the mission's ``scenario.seed``."""
     gui: bool = False
     """Open PyBullet's window (default: headless, ``p.DIRECT``)."""
     realtime: bool = False
@@ -88,7 +87,7 @@ class SimOptions:
     laser_model: Literal["fast", "bullet"] = "fast"
     """``fast``: vectorised 2-D ray casting; ``bullet``: PyBullet's ``rayTestBatch``."""
     camera: bool = True
-    """Render the RGB-D camera (about 20 ms a frame at 320x240 in the house)."""
+    """Render the RGB-D camera (the slowest part of a step)."""
 
 
 def segment_distance(xy: np.ndarray, segs: np.ndarray) -> float:
@@ -104,18 +103,18 @@ def segment_distance(xy: np.ndarray, segs: np.ndarray) -> float:
 class SimRobot:
     """The simulated HSR-like robot in the house (implements ``pfctl.core.robot.Robot``)."""
 
-    def __init__(self, mission: Mission, options: SimOptions | None = None) -> None:
-        self.mission = mission
+    def __init__(self, config: SimConfig, options: SimOptions | None = None) -> None:
+        self.config = config
         self.options = options or SimOptions()
-        self.seed = mission.scenario.seed if self.options.seed is None else self.options.seed
-        rc, sensors = mission.robot, mission.sensors
-        self.static_map = rasterize_house(
-            mission.layout(), mission.map.resolution, mission.map.wall_thickness
-        )
+        self.seed = config.seed
+        rc, house = config.robot, config.house
+        self.static_map = rasterize_house(house.layout, house.resolution, house.wall_thickness)
         self.planner = GridPlanner(self.static_map, rc.radius)
-        self.people: list[Walker] = make_walkers(mission, self.planner, self.seed)
+        self.people: list[Walker] = make_walkers(
+            config.scenario, house.layout, self.planner, self.seed
+        )
         self.navigator = Navigator(self.planner, rc.max_linear_speed, rc.max_angular_speed)
-        self.laser_spec = LaserSpec.from_config(sensors.laser)
+        self.laser_spec = LaserSpec.from_config(config.laser)
         rngs = [np.random.default_rng([self.seed, k]) for k in range(4)]
         laser_seed, camera_seed = (int(r.integers(2**31)) for r in rngs[:2])
         self._pose_rng, self._odom_rng = rngs[2], rngs[3]
@@ -123,29 +122,27 @@ class SimRobot:
         self._client = p.connect(p.GUI if self.options.gui else p.DIRECT)
         self._closed = False
         try:
-            self.world = build_world(self._client, mission)
+            self.world = build_world(self._client, house)
             self.people_bodies = PeopleBodies(self._client, self.people, seed=self.seed)
-            self.robot_body = RobotBody(self._client, rc.radius, sensors.camera.mount_height)
+            self.robot_body = RobotBody(self._client, rc.radius, config.camera.mount_height)
             self.laser: FastLaser | BulletLaser = (
                 BulletLaser(self._client, self.laser_spec, laser_seed)
                 if self.options.laser_model == "bullet"
                 else FastLaser(self.world.scene.segments, self.laser_spec, laser_seed, True)
             )
             self.camera = (
-                SimCamera(self._client, sensors.camera, camera_seed)
-                if self.options.camera
-                else None
+                SimCamera(self._client, config.camera, camera_seed) if self.options.camera else None
             )
             if self.options.gui:
                 self._setup_window()
         except BaseException:
             p.disconnect(self._client)
             raise
-        self.pose = Pose2D(*mission.start_pose())
+        self.pose = config.start
         self.odometry = Pose2D(0.0, 0.0, 0.0)
         self.head = HeadServo(rc)
-        period = 1.0 / mission.behavior.tick_hz
-        rate = max(sensors.laser.rate_hz, MIN_SUBSTEP_HZ)
+        period = config.tick_period
+        rate = max(config.laser.rate_hz, MIN_SUBSTEP_HZ)
         self.substeps = max(1, math.ceil(period * rate - 1e-9))
         """Sub-steps per control period: none longer than the laser's period."""
         self.substep = period / self.substeps
@@ -178,8 +175,8 @@ class SimRobot:
     # -- the Robot port -------------------------------------------------------------------------
 
     def clamp(self, t: Twist2D) -> Twist2D:
-        """The command within the mission's linear (vx, vy norm) and angular limits."""
-        rc = self.mission.robot
+        """The command within the robot's linear (vx, vy norm) and angular limits."""
+        rc = self.config.robot
         n = math.hypot(t.vx, t.vy)
         k = min(1.0, rc.max_linear_speed / n) if n > 0 else 1.0
         wz = max(-rc.max_angular_speed, min(rc.max_angular_speed, t.wz))
@@ -219,7 +216,7 @@ class SimRobot:
         self._navigating, self._cmd = False, STOP
 
     def step(self) -> None:
-        """Advance one control period ``1 / behavior.tick_hz``."""
+        """Advance one control period (``tick_period``)."""
         for _ in range(self.substeps):
             self.advance_substep()
         if self.options.gui:
@@ -242,7 +239,7 @@ class SimRobot:
         self._move(dt)
         self._localization_step(dt)
         self.head.update(dt)
-        clear = self.mission.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
+        clear = self.config.robot.radius + PERSON_CONTACT_RADIUS + PERSON_COURTESY
         for walker in self.people:
             walker.step(dt, keep_clear=(self.pose.x, self.pose.y, clear))
         self._ticks += 1
@@ -300,7 +297,7 @@ class SimRobot:
     # -- internals ---------------------------------------------------------------------------------
 
     def _blocked(self, x: float, y: float) -> bool:
-        r = self.mission.robot.radius
+        r = self.config.robot.radius
         if segment_distance(np.array([x, y]), self.world.scene.segments) <= r:
             return True
         reach = r + PERSON_CONTACT_RADIUS
@@ -323,7 +320,7 @@ class SimRobot:
         self._odometry_step(dx, dy, dth)
 
     def _odometry_step(self, dx: float, dy: float, dth: float) -> None:
-        noise = self.mission.sensors.pose
+        noise = self.config.pose_noise
         if noise.odometry_linear > 0 and (dx or dy):
             k = noise.odometry_linear * math.sqrt(math.hypot(dx, dy))
             dx += k * float(self._odom_rng.normal())
@@ -335,8 +332,8 @@ class SimRobot:
 
     def _localization_step(self, dt: float) -> None:
         """The localisation error as a first-order Gauss-Markov process (correlation time
-        :data:`LOCALIZATION_TAU`) whose steady-state std is ``sensors.pose.localization_*``."""
-        noise = self.mission.sensors.pose
+        :data:`LOCALIZATION_TAU`) whose steady-state std is ``pose_noise.localization_*``."""
+        noise = self.config.pose_noise
         if noise.localization_xy == 0 and noise.localization_theta == 0:
             return
         a = math.exp(-dt / LOCALIZATION_TAU)
@@ -378,7 +375,7 @@ class SimRobot:
             self._scan_points = scan.points()  # MOVE_BASE's view, with the true pose
             believed = self.laser_spec.laser_pose(self.localized_pose)
             self._scan = scan if believed == scan.pose else replace(scan, pose=believed)
-            period = 1.0 / self.mission.sensors.laser.rate_hz
+            period = 1.0 / self.config.laser.rate_hz
             while self._next_scan <= self.time + eps:
                 self._next_scan += period
         if self.camera is not None and self.time >= self._next_frame - eps:
@@ -387,13 +384,13 @@ class SimRobot:
             frame = self.camera.render(self.pose, self.head.state, self.time)
             # Rendered from the true pose, posed where the robot believes its camera is (as the
             # scans are), so that laser and camera positions agree in the follower's map frame.
-            cam = self.mission.sensors.camera
+            cam = self.config.camera
             position, rotation = camera_pose(
                 self.localized_pose, self.head.state, cam.mount_height, cam.forward_offset
             )
             x, y, z = (float(v) for v in position)
             self._frame = replace(frame, camera_position=(x, y, z), camera_rotation=rotation)
-            period = 1.0 / self.mission.sensors.camera.rate_hz
+            period = 1.0 / self.config.camera.rate_hz
             while self._next_frame <= self.time + eps:
                 self._next_frame += period
 
@@ -408,7 +405,7 @@ class SimRobot:
     def _setup_window(self) -> None:
         c = self._client
         p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
-        x0, y0, x1, y1 = house_bounds(self.mission.layout())
+        x0, y0, x1, y1 = house_bounds(self.config.house.layout)
         p.resetDebugVisualizerCamera(
             cameraDistance=0.9 * max(x1 - x0, y1 - y0),
             cameraYaw=0.0,

@@ -20,9 +20,10 @@ from dataclasses import dataclass
 import numpy as np
 import shapely
 
+from pfctl.backends.pybullet.config import Clothes, PersonConfig, ScenarioConfig
+from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import PersonTruth
-from pfctl.mission import Mission, Person
 
 #: A person's footprint for planning, metres.
 PERSON_RADIUS = 0.25
@@ -41,14 +42,6 @@ RANDOMIZE = 7919
 
 
 @dataclass(frozen=True)
-class WalkerClothes:
-    """Clothes colours, RGB 0..255."""
-
-    upper: tuple[int, int, int]
-    lower: tuple[int, int, int]
-
-
-@dataclass(frozen=True)
 class WalkerState:
     """A person at one instant: pose, speed, looks and leg positions (map frame)."""
 
@@ -59,7 +52,7 @@ class WalkerState:
     speed: float
     is_target: bool
     height: float
-    clothes: WalkerClothes
+    clothes: Clothes
     legs: np.ndarray
     """Rows ``[x, y, radius]`` of the two legs."""
     paused: bool = False
@@ -103,7 +96,7 @@ class Walker:
         planner: GridPlanner,
         *,
         speed: float,
-        clothes: WalkerClothes,
+        clothes: Clothes,
         height: float = 1.7,
         pause_s: float = 2.0,
         loop: bool = False,
@@ -267,14 +260,14 @@ class Walker:
 
 
 def _stops(
-    mission: Mission,
-    person: Person,
+    scenario: ScenarioConfig,
+    layout: HouseLayout,
+    person: PersonConfig,
     planner: GridPlanner,
     rng: np.random.Generator,
     jitter_rng: np.random.Generator | None = None,
 ) -> list[np.ndarray]:
-    layout = mission.layout()
-    jitter = mission.scenario.randomize.route_jitter
+    jitter = scenario.randomize.route_jitter
     out = []
     for stop in person.route:
         if isinstance(stop, str):
@@ -285,13 +278,13 @@ def _stops(
                 raise NoPathError(f"{person.name}: route point {stop} is not free for a person")
             point = np.asarray(p, dtype=float)
             if jitter > 0 and jitter_rng is not None:
-                point = _jittered(mission, planner, point, jitter, jitter_rng)
+                point = _jittered(layout, planner, point, jitter, jitter_rng)
             out.append(point)
     return out
 
 
 def _jittered(
-    mission: Mission,
+    layout: HouseLayout,
     planner: GridPlanner,
     point: np.ndarray,
     jitter: float,
@@ -300,7 +293,7 @@ def _jittered(
 ) -> np.ndarray:
     """``point`` moved by up to ``jitter`` metres (uniform over the disc) to a free spot of the
     same region (``scenario.randomize.route_jitter``); ``point`` itself if no draw lands there."""
-    regions = [shapely.Polygon(r.polygon) for r in mission.layout().regions]
+    regions = [shapely.Polygon(r.polygon) for r in layout.regions]
     home = next((r for r in regions if r.covers(shapely.Point(point))), None)
     for _ in range(tries):
         r = jitter * math.sqrt(float(rng.uniform()))
@@ -312,21 +305,21 @@ def _jittered(
 
 
 def _random_walkers(
-    mission: Mission,
+    scenario: ScenarioConfig,
+    layout: HouseLayout,
     planner: GridPlanner,
     rng: np.random.Generator,
     taken: set[str],
     count: int | None = None,
     *,
     prefix: str = "walker",
-    dress_like: WalkerClothes | None = None,
+    dress_like: Clothes | None = None,
     jitter: int = 0,
 ) -> list[Walker]:
     """``count`` (default ``scenario.random_people``) distractors: random free stops, clothes
     and speed; with ``dress_like``, clothes within ``jitter`` of those per RGB channel."""
-    layout = mission.layout()
     walkers = []
-    for i in range(mission.scenario.random_people if count is None else count):
+    for i in range(scenario.random_people if count is None else count):
         name = f"{prefix}_{i}"
         while name in taken:
             name += "_"
@@ -335,12 +328,12 @@ def _random_walkers(
         for r in regions:
             stops.append(_region_point(planner, layout.regions[int(r)].polygon, rng))
         if dress_like is None:
-            clothes = WalkerClothes(
+            clothes = Clothes(
                 tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
                 tuple(int(v) for v in rng.integers(0, 256, 3)),  # type: ignore[arg-type]
             )
         else:
-            clothes = WalkerClothes(
+            clothes = Clothes(
                 _near(dress_like.upper, jitter, rng), _near(dress_like.lower, jitter, rng)
             )
         walkers.append(
@@ -359,10 +352,12 @@ def _random_walkers(
     return walkers
 
 
-def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
-    """The scenario's people (plus ``random_people`` distractors, and what
-    ``scenario.randomize`` adds: speeds, moved route points, extra distractors and look-alikes
-    dressed like the target), deterministic for ``seed``.
+def make_walkers(
+    scenario: ScenarioConfig, layout: HouseLayout, planner: GridPlanner, seed: int
+) -> list[Walker]:
+    """The scenario's people in the house ``layout`` (plus ``random_people`` distractors, and
+    what ``scenario.randomize`` adds: speeds, moved route points, extra distractors and
+    look-alikes dressed like the target), deterministic for ``seed``.
 
     ``planner`` may be the robot's: routes are planned with a copy for :data:`PERSON_RADIUS`.
     Raises :class:`NoPathError` if a route cannot be walked.
@@ -370,14 +365,14 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
     if abs(planner.robot_radius - PERSON_RADIUS) > 1e-9:
         planner = planner.with_radius(PERSON_RADIUS)
     rng = np.random.default_rng(seed)
-    vary = mission.scenario.randomize
+    vary = scenario.randomize
     # scenario.randomize draws from streams of its own: the draws above stay as they were
     speed_rng, jitter_rng, extra_rng = (
         np.random.default_rng([seed, RANDOMIZE, k]) for k in range(3)
     )
     walkers = []
-    for person in mission.scenario.people:
-        clothes = WalkerClothes(
+    for person in scenario.people:
+        clothes = Clothes(
             tuple(int(v) for v in person.clothes.upper),  # type: ignore[arg-type]
             tuple(int(v) for v in person.clothes.lower),  # type: ignore[arg-type]
         )
@@ -388,27 +383,30 @@ def make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walk
         walkers.append(
             Walker(
                 person.name,
-                _stops(mission, person, planner, rng, jitter_rng),
+                _stops(scenario, layout, person, planner, rng, jitter_rng),
                 planner,
                 speed=speed,
                 clothes=clothes,
                 height=person.height,
                 pause_s=person.pause_s,
                 loop=person.loop,
-                is_target=person.name == mission.scenario.target,
+                is_target=person.name == scenario.target,
                 seed=int(rng.integers(2**31)),
             )
         )
-    walkers += _random_walkers(mission, planner, rng, {w.name for w in walkers})
+    walkers += _random_walkers(scenario, layout, planner, rng, {w.name for w in walkers})
     extra = int(extra_rng.integers(vary.extra_people[0], vary.extra_people[1] + 1))
     alikes = int(extra_rng.integers(vary.look_alikes[0], vary.look_alikes[1] + 1))
     if extra:
         taken = {w.name for w in walkers}
-        walkers += _random_walkers(mission, planner, extra_rng, taken, extra, prefix="extra")
+        walkers += _random_walkers(
+            scenario, layout, planner, extra_rng, taken, extra, prefix="extra"
+        )
     target = next((w for w in walkers if w.is_target), None)
     if alikes and target is not None:
         walkers += _random_walkers(
-            mission,
+            scenario,
+            layout,
             planner,
             extra_rng,
             {w.name for w in walkers},
@@ -426,4 +424,4 @@ def _near(rgb: tuple[int, int, int], jitter: int, rng: np.random.Generator) -> t
     return tuple(int(v) for v in np.clip(moved, 0, 255))  # type: ignore[return-value]
 
 
-__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerClothes", "WalkerState", "make_walkers"]
+__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerState", "make_walkers"]

@@ -2,11 +2,10 @@
 
 - Each region's floor is a flat mesh of its polygon (rooms get slightly different tints), over an
   invisible ground plane that carries the collisions.
-- Walls are the boxes of :func:`pfctl.core.mapping.walls.wall_boxes` extruded to
-``map.wall_height``,
-  with gaps at the doors.
-- Furniture (``map.obstacles``) is its polygon extruded to its height, as a visual mesh and a
-  static triangle-mesh collision shape, so concave pieces are exact.
+- Walls are the boxes of :func:`pfctl.core.mapping.walls.wall_boxes` extruded to the house's
+  ``wall_height``, with gaps at the doors.
+- Furniture (the layout's obstacles) is its polygon extruded to its height, as a visual mesh and
+  a static triangle-mesh collision shape, so concave pieces are exact.
 
 The same geometry is kept in 2-D for the fast laser and the base's collisions:
 :class:`StaticScene` holds every body's outline as counter-clockwise segments.
@@ -21,8 +20,8 @@ import pybullet as p
 import shapely
 from shapely.geometry.polygon import orient
 
+from pfctl.backends.pybullet.config import HouseConfig
 from pfctl.core.mapping.walls import wall_boxes
-from pfctl.mission import Mission
 
 WALL_RGBA = (0.86, 0.85, 0.80, 1.0)
 FURNITURE_RGBA = (0.55, 0.38, 0.24, 1.0)
@@ -130,21 +129,21 @@ def _mesh_body(
     return p.createMultiBody(0, col, vis, physicsClientId=client)
 
 
-def build_world(client: int, mission: Mission) -> World:
+def build_world(client: int, house: HouseConfig) -> World:
     """Ground, floors, walls (``wall_boxes`` extruded to ``wall_height``) and furniture."""
     ground_col = p.createCollisionShape(p.GEOM_PLANE, physicsClientId=client)
     ground_vis = p.createVisualShape(
         p.GEOM_BOX, halfExtents=[0.01, 0.01, 0.01], rgbaColor=[0, 0, 0, 0], physicsClientId=client
     )
     world = World(ground=p.createMultiBody(0, ground_col, ground_vis, physicsClientId=client))
-    layout = mission.layout()
+    layout = house.layout
     for k, region in enumerate(layout.regions):
         rgba = (*FLOOR_TINTS[k % len(FLOOR_TINTS)], 1.0)
         top = prism_mesh(shapely.Polygon(region.polygon), 0.0, 0.0, sides=False)
         world.floors[region.name] = _mesh_body(client, top, rgba, solid=False)
     segs: list[list[float]] = []
-    height = mission.map.wall_height
-    for box in wall_boxes(layout, mission.map.wall_thickness):
+    height = house.wall_height
+    for box in wall_boxes(layout, house.wall_thickness):
         half = (box.length / 2.0, box.thickness / 2.0, height / 2.0)
         body = _box(client, box.center[0], box.center[1], box.yaw, half)
         world.walls.append(body)

@@ -43,7 +43,7 @@ ROS_MODULES = (
     "actionlib_msgs.msg",
 )
 READY_TIMEOUT = 20.0
-"""Wall seconds a master may take to answer (far more than it needs, for a busy machine)."""
+"""Wall seconds a master may take to answer."""
 NODE_TIMEOUT = 60.0
 """Wall seconds a test node process may run before it counts as hung."""
 

@@ -206,9 +206,7 @@ def test_search_over_ros_finds_the_hidden_target(
 ) -> None:
     """``pfctl search --backend hsr`` against ``serve-hsr --hide living_room``: the robot
     starts in the kitchen without the target in view, searches (belief, Algorithm 1, frontiers)
-    and identifies her through the door. Seed 2, on which the simulator finds her too; seed 1 is
-    no test: she stands side-on to the laser there, her legs show as one segment below the leg
-    threshold, and Algorithm 2 waits for legs."""
+    and identifies her through the door (seed 2, where she shows her legs to the laser)."""
     bridge_log = tmp_path / "serve.log"
     bridge = _spawn(
         [*PFCTL, "sim", "serve-hsr", str(HOUSE), "--seed", "2", "--hide", "living_room",

@@ -1,4 +1,5 @@
-"""A LaserScan made by pfctl.backends.hsr.convert goes through a real ROS 1 master.
+"""A LaserScan made by pfctl.backends.hsr.convert goes through a real ROS 1 master; the master
+check of pfctl.backends.hsr.master.
 
 Two node processes (talker, listener) use the test's private ``rosmaster``; pytest's own process
 never calls ``rospy.init_node`` (one node per process, see conftest).
@@ -15,10 +16,13 @@ import time
 import numpy as np
 import pytest
 
+from pfctl.backends.hsr.master import MasterError, check_master
+from tests.backends.hsr.conftest import _free_port
+
 pytestmark = pytest.mark.ros
 
 NODE_TIMEOUT = 60.0
-"""Wall seconds a node may take (far more than it needs, for a busy machine)."""
+"""Wall seconds a node may take."""
 
 NODE_PRELUDE = """
 import json, sys
@@ -107,3 +111,11 @@ def test_master_fixture_is_private(ros_master):
     assert ros_master.env["ROS_LOG_DIR"].startswith(str(ros_master.log.parent))
     assert proxy.setParam("/pytest", "/use_sim_time", True)[0] == 1
     assert proxy.getParam("/pytest", "/use_sim_time")[2] is True
+
+
+def test_check_master_passes_a_live_master_and_says_why_there_is_none(ros_master):
+    check_master(ros_master.uri, "/pytest")
+    uri = f"http://127.0.0.1:{_free_port()}/"
+    with pytest.raises(MasterError) as info:
+        check_master(uri, "/pytest", timeout=1.0)
+    assert isinstance(info.value.error, OSError) and info.value.answer == ""

@@ -1,5 +1,5 @@
 """Person keypoints (``backend.hsr.person_keypoints``, a ``sensor_msgs/PointCloud`` of 2-D
-keypoints and boxes, :mod:`pfctl.backends.hsr.person_keypoints`): the message ⇄ people
+keypoints and boxes, :mod:`pfctl.bags.person_keypoints`): the message ⇄ people
 conversion with the real ROS message classes, and the whole path over a private master —
 ``pfctl sim serve-hsr`` standing in for OpenPose, ``HsrRobot`` receiving frames that carry the
 people, the GivenPersonDetector placing them where the simulator's truth has them (§II-E).
@@ -15,7 +15,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from pfctl.backends.hsr.person_keypoints import (
+from pfctl.backends.hsr.robot import RobotDataError, frame_people
+from pfctl.bags.person_keypoints import (
     BOX_BOTTOM_RIGHT,
     BOX_TOP_LEFT,
     cloud_message,
@@ -23,7 +24,6 @@ from pfctl.backends.hsr.person_keypoints import (
     people_from_cloud,
     read_cloud,
 )
-from pfctl.backends.hsr.robot import RobotDataError, frame_people
 from pfctl.core.robot import GivenPerson
 from tests.backends.hsr.conftest import RosMaster
 from tests.backends.hsr.test_robot import Output
@@ -37,11 +37,9 @@ NODES = Path(__file__).parent / "nodes"
 TOPIC = "/pfctl/person_keypoints"
 SHAPE = (240, 320)
 #: Horizontal distance (m) within which every person the GivenPersonDetector places from the
-#: served keypoints lies from the simulator's truth at the frame's stamp. Measured on the house's
-#: episode held until the robot's first command (alice ahead of the robot, walking away): first
-#: 10 frames max 0.036 m, median 0.028 m; first 30 frames max 0.089 m, median 0.031 m (the label
-#: detector on the same frames: max 0.064 m, median 0.022 m). The test looks at 10 frames; a
-#: loaded machine may skip some and reach later ones.
+#: served keypoints lies from the simulator's truth at the frame's stamp, on the house's episode
+#: held until the robot's first command (alice ahead of the robot, walking away). The test looks
+#: at 10 frames; a loaded machine may skip some and reach later ones.
 TRUTH_TOLERANCE = 0.12
 
 

@@ -25,7 +25,7 @@ pytestmark = pytest.mark.ros
 
 NODES = Path(__file__).parent / "nodes"
 WAIT = 30.0
-"""Wall seconds any one expected line may take (they take ~1-3 s here)."""
+"""Wall seconds any one expected line may take."""
 BAD_BEAMS = (10, 20, 30, 40, 50)  # fake_hsr.BAD_BEAMS: NaN, +inf, -inf, < range_min, > range_max
 N_BEAMS = 181
 BASE = (1.5, 2.0, math.pi / 2)  # fake_hsr: map→odom ⊕ odom→base_footprint
@@ -323,6 +323,7 @@ def test_missing_laser_is_one_line_naming_the_topic(ros_master, ros_nodes):
 
 def test_unreachable_master_is_one_line(ros, monkeypatch):
     """No master: a clear error before rospy's init_node (which would block forever)."""
+    from pfctl.app.hsr import hsr_config
     from pfctl.backends.hsr.robot import HsrRobot, RobotConnectionError
     from pfctl.mission import load_mission
 
@@ -332,7 +333,7 @@ def test_unreachable_master_is_one_line(ros, monkeypatch):
     monkeypatch.setenv("ROS_MASTER_URI", uri)
     mission = load_mission(Path(__file__).parents[3] / "missions" / "house.yaml")
     with pytest.raises(RobotConnectionError) as info:
-        HsrRobot(mission)
+        HsrRobot(hsr_config(mission))
     message = str(info.value)
     assert message.startswith(f"cannot reach the ROS master at {uri} (")
     assert "\n" not in message and info.value.exit_code == 2

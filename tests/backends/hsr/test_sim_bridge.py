@@ -21,6 +21,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pfctl.app.hsr import hsr_config
+from pfctl.app.sim import sim_config
 from pfctl.backends.hsr import convert
 from pfctl.backends.hsr.sim_bridge import CLOCK_OFFSET, HsrMessages, ros_time
 from pfctl.backends.pybullet.camera import camera_pose, intrinsics
@@ -589,10 +591,14 @@ def test_stamps_are_whole_nanoseconds_of_sim_time_plus_the_offset(ros):
     assert ros_time(0.0, offset=100.5).to_nsec() == 100_500_000_000
 
 
+def _messages(mission, depth_encoding: str = "16UC1") -> HsrMessages:
+    return HsrMessages(hsr_config(mission), sim_config(mission).laser, depth_encoding)
+
+
 def _observation(mission, pose: Pose2D, odometry: Pose2D, head: HeadState) -> Observation:
     cam = mission.sensors.camera
     position, rotation = camera_pose(pose, head, cam.mount_height, cam.forward_offset)
-    info = intrinsics(cam)
+    info = intrinsics(sim_config(mission).camera)
     depth = np.full((info.height, info.width), 2.5, dtype=np.float32)
     depth[0, 0] = np.inf
     frame = RgbdFrame(
@@ -620,7 +626,7 @@ def _matrix(transform) -> np.ndarray:
 def test_tf_chain_puts_the_camera_where_the_frame_says(ros):
     """map → odom → base_footprint → optical frame = the frame's camera pose (map frame)."""
     mission = load_mission(HOUSE)
-    msgs = HsrMessages(mission)
+    msgs = _messages(mission)
     pose, odometry = Pose2D(3.0, 2.0, 0.7), Pose2D(0.4, -0.2, 0.3)
     obs = _observation(mission, pose, odometry, HeadState(0.4, -0.3))
     tf = msgs.tf(obs)
@@ -645,7 +651,7 @@ def test_camera_messages_share_stamp_and_frame_in_either_depth_encoding(ros):
     labels = np.zeros(obs.rgbd.depth.shape, np.uint16)
     labels[10, 20] = 7
     for encoding, none in (("16UC1", 0), ("32FC1", None)):
-        rgb, depth, info, lab = HsrMessages(mission, encoding).camera(obs.rgbd, labels)
+        rgb, depth, info, lab = _messages(mission, encoding).camera(obs.rgbd, labels)
         assert {m.header.frame_id for m in (rgb, depth, info, lab)} == {
             "head_rgbd_sensor_rgb_frame"
         }
@@ -658,7 +664,7 @@ def test_camera_messages_share_stamp_and_frame_in_either_depth_encoding(ros):
         assert lab.encoding == "16UC1"
         assert np.frombuffer(bytes(lab.data), "<u2").reshape(labels.shape)[10, 20] == 7
     with pytest.raises(ValueError, match="8UC1"):
-        HsrMessages(mission, "8UC1")
+        _messages(mission, "8UC1")
 
 
 def test_truth_markers_read_back_as_the_people(ros):
@@ -668,7 +674,7 @@ def test_truth_markers_read_back_as_the_people(ros):
         PersonTruth("bob", 7.0, 1.0, -2.0, 0.7),
     )
     truth = GroundTruth(stamp=0.3, robot=Pose2D(1.0, 3.3, 0.1), people=people, collisions=2)
-    robot, markers, collisions = HsrMessages(mission).truth(truth)
+    robot, markers, collisions = _messages(mission).truth(truth)
     assert robot.header.frame_id == "map" and robot.header.stamp.to_nsec() == 100_300_000_000
     assert convert.pose2d_from_pose(robot.pose).distance_to(truth.robot) < 1e-12
     assert collisions.data == 2
@@ -683,7 +689,7 @@ def test_truth_markers_read_back_as_the_people(ros):
 
 
 def test_goals_in_odom_and_base_frames_are_taken_to_the_map(ros):
-    msgs = HsrMessages(load_mission(HOUSE))
+    msgs = _messages(load_mission(HOUSE))
     pose, odometry = Pose2D(2.0, 3.0, math.pi / 2), Pose2D(0.5, 0.0, 0.2)
     goal = Pose2D(1.0, 0.0, 0.0)
 

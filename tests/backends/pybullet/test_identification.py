@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 from rich.progress import Progress
 
+from pfctl.app.learn_target import learn_in_sim
 from pfctl.app.perception import identity_params
-from pfctl.backends.hsr.person_keypoints import detection_parts, given_person
-from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.commands.learn_target import learn_in_sim
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.simulation import SimRobot
+from pfctl.bags.person_keypoints import detection_parts, given_person
 from pfctl.core.perception.faces import FaceEncoder, face_distance
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
 from pfctl.core.perception.identity.profile import describe, learn_profile
@@ -83,7 +84,7 @@ def _detector(robot: SimRobot) -> MaskPersonDetector:
 def test_rendered_faces_match_the_same_person_across_views_and_no_one_else() -> None:
     encoder = FaceEncoder()
     faces: dict[str, list[np.ndarray]] = {}
-    with SimRobot(_scene(), SimOptions()) as robot:
+    with SimRobot(sim_config(_scene())) as robot:
         detector = _detector(robot)
         for dist, turn in ((1.5, 0.0), (2.0, 0.3), (2.5, -0.3)):
             x = ROBOT[0] + dist
@@ -118,7 +119,7 @@ def test_algorithm2_picks_the_target_among_look_alikes_and_keeps_it_when_backs_t
         learned = learn_in_sim(mission, 3.0, 5, params, progress)
     profile = learn_profile(learned.appearances, params)
     assert len(profile.faces) > 0
-    with SimRobot(mission, SimOptions(seed=5)) as robot:
+    with SimRobot(sim_config(mission, 5)) as robot:
         detector = _detector(robot)
         identifier = TargetIdentifier(profile, params)
         x = ROBOT[0] + 2.0
@@ -151,7 +152,7 @@ def test_algorithm2_picks_the_target_among_look_alikes_and_keeps_it_when_backs_t
 
 @pytest.mark.parametrize("size", [(320, 240), (640, 480)])
 def test_mask_detector_places_people_within_15cm_of_the_truth(size: tuple[int, int]) -> None:
-    with SimRobot(_scene(*size), SimOptions()) as robot:
+    with SimRobot(sim_config(_scene(*size))) as robot:
         detector = _detector(robot)
         given = GivenPersonDetector()
         errors, given_errors, keypoint_errors, keypoint_vs_mask = [], [], [], []
@@ -187,8 +188,7 @@ def test_mask_detector_places_people_within_15cm_of_the_truth(size: tuple[int, i
                 assert det.keypoints is not None and "neck" in det.keypoints
     assert max(errors) < 0.15
     assert max(given_errors) < 0.15  # a box's central depth (HOG's way) works as well here
-    # the torso keypoints' depth: close to the truth and to the mask detector's position (both
-    # sizes)
+    # the torso keypoints' depth, against the truth and the mask detector's position (both sizes)
     assert max(keypoint_errors) < 0.08 and max(keypoint_vs_mask) < 0.1
 
 
@@ -196,7 +196,7 @@ def test_mask_detector_places_people_within_15cm_of_the_truth(size: tuple[int, i
 def test_hog_on_a_rendered_person_reports_only_consistent_boxes() -> None:
     """OpenCV's HOG (trained on photos of people) rarely fires on the blocky simulated people;
     what it does report must be a person-shaped box whose depth places it where someone is."""
-    with SimRobot(_scene(), SimOptions()) as robot:
+    with SimRobot(sim_config(_scene())) as robot:
         _line_up(
             robot, {"alice": (4.0, 3.0, 0.0), "carol": (8.0, 1.0, 0.0), "bob": (8.0, 5.0, 0.0)}
         )
@@ -212,12 +212,13 @@ def test_hog_on_a_rendered_person_reports_only_consistent_boxes() -> None:
 
 
 def test_describe_on_a_rendered_person_splits_shirt_from_trousers() -> None:
-    with SimRobot(_scene(320, 240), SimOptions()) as robot:
+    mission = _scene(320, 240)
+    with SimRobot(sim_config(mission)) as robot:
         _line_up(
             robot, {"alice": (3.8, 2.4, 0.0), "carol": (8.0, 1.0, 0.0), "bob": (3.8, 3.6, 0.0)}
         )
         frame = _frame(robot, -0.1)
-        params = identity_params(robot.mission)
+        params = identity_params(mission)
         looks = {
             d.ground_truth_name: describe(frame.rgb, d, params)
             for d in _detector(robot).detect(frame)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from pfctl.app.leg_models import load_leg_model
+from pfctl.app.sim import house_config
 from pfctl.backends.pybullet.laser import FastLaser
 from pfctl.backends.pybullet.leg_scans import LASERS, LegScanGenerator, simulate_leg_scans
 from pfctl.backends.pybullet.walkers import LEG_RADIUS
@@ -24,7 +25,7 @@ HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 @pytest.fixture(scope="module")
 def generator() -> LegScanGenerator:
-    return LegScanGenerator(load_mission(HOUSE))
+    return LegScanGenerator(house_config(load_mission(HOUSE)))
 
 
 def test_scans_are_seeded_and_labelled(generator: LegScanGenerator) -> None:
@@ -32,7 +33,7 @@ def test_scans_are_seeded_and_labelled(generator: LegScanGenerator) -> None:
     b = generator.draw(np.random.default_rng(5))
     np.testing.assert_array_equal(a.scan.ranges, b.scan.ranges)
     assert a.legs.shape == (2 * a.people, 3)
-    scans = list(simulate_leg_scans(load_mission(HOUSE), 40, seed=1))
+    scans = list(simulate_leg_scans(house_config(load_mission(HOUSE)), 40, seed=1))
     assert {s.laser for s in scans} == {m.name for m in LASERS}
     people = [s.people for s in scans]
     assert min(people) >= 0 and max(people) <= 8 and sum(people) > 40

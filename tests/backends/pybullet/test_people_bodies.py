@@ -9,22 +9,27 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.people_bodies import PeopleBodies, face_texture
-from pfctl.backends.pybullet.walkers import LEG_RADIUS, make_walkers
+from pfctl.backends.pybullet.walkers import LEG_RADIUS, Walker, make_walkers
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import rasterize_house
-from pfctl.mission import load_mission
+from pfctl.mission import Mission, load_mission
 
 pytestmark = pytest.mark.sim
 
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
 
 
+def _make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
+    return make_walkers(sim_config(mission).scenario, mission.layout(), planner, seed)
+
+
 @pytest.fixture()
 def world():
     mission = load_mission(HOUSE)
     grid = rasterize_house(mission.layout(), mission.map.resolution, mission.map.wall_thickness)
-    walkers = make_walkers(mission, GridPlanner(grid, mission.robot.radius), seed=7)
+    walkers = _make_walkers(mission, GridPlanner(grid, mission.robot.radius), seed=7)
     client = p.connect(p.DIRECT)
     bodies = PeopleBodies(client, walkers, seed=7)
     yield client, walkers, bodies

@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 import yaml
 
-from pfctl.backends.pybullet.walkers import PERSON_RADIUS, make_walkers
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.walkers import PERSON_RADIUS, Walker, make_walkers
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.errors import MissionError
 from pfctl.mission import Mission, ScenarioConfig, loads_mission
@@ -18,6 +19,10 @@ from pfctl.mission import Mission, ScenarioConfig, loads_mission
 pytestmark = pytest.mark.sim
 
 HOUSE = Path(__file__).resolve().parents[3] / "missions" / "house.yaml"
+
+
+def _make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
+    return make_walkers(sim_config(mission).scenario, mission.layout(), planner, seed)
 
 
 def _with(mission: Mission, **randomize: Any) -> Mission:
@@ -34,8 +39,8 @@ def _summary(walkers: list) -> list[tuple]:
 
 def test_off_by_default(mission: Mission, planner: GridPlanner) -> None:
     assert mission.scenario.randomize == _with(mission).scenario.randomize
-    assert _summary(make_walkers(mission, planner, 4)) == _summary(
-        make_walkers(_with(mission), planner, 4)
+    assert _summary(_make_walkers(mission, planner, 4)) == _summary(
+        _make_walkers(_with(mission), planner, 4)
     )
 
 
@@ -55,9 +60,9 @@ def test_randomize_varies_by_seed_and_keeps_the_other_draws(
     target = people[mission.scenario.target]
     counts = set()
     for seed in range(6):
-        plain = {w.name: w for w in make_walkers(mission, planner, seed)}
-        walkers = make_walkers(varied, planner, seed)
-        assert _summary(walkers) == _summary(make_walkers(varied, planner, seed))  # seeded
+        plain = {w.name: w for w in _make_walkers(mission, planner, seed)}
+        walkers = _make_walkers(varied, planner, seed)
+        assert _summary(walkers) == _summary(_make_walkers(varied, planner, seed))  # seeded
         named = [w for w in walkers if w.name in people]
         extra = [w for w in walkers if w.name.startswith("extra_")]
         alikes = [w for w in walkers if w.name.startswith("look_alike_")]
@@ -109,6 +114,6 @@ def test_search_hides_the_target_in_one_of_hide_in(mission: Mission) -> None:
     varied = _with(mission, hide_in=["bedroom", "living_room"])
     seen = set()
     for seed in range(4):
-        with SimRobot(varied, SimOptions(seed=seed, camera=False)) as robot:
-            seen.add(hide_target(robot, None))
+        with SimRobot(sim_config(varied, seed), SimOptions(camera=False)) as robot:
+            seen.add(hide_target(varied, robot, None))
     assert seen == {"bedroom", "living_room"}

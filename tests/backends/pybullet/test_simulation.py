@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.backends.pybullet.walkers import LEG_RADIUS
 from pfctl.core.robot import HeadTarget, NavStatus, Pose2D, Robot, Twist2D
@@ -59,7 +60,9 @@ def _empty(mission: Mission) -> Mission:
 def test_scan_of_an_empty_room_matches_its_walls_within_noise(
     two_rooms: Mission, model: str
 ) -> None:
-    with SimRobot(_empty(two_rooms), SimOptions(camera=False, laser_model=model)) as robot:
+    with SimRobot(
+        sim_config(_empty(two_rooms)), SimOptions(camera=False, laser_model=model)
+    ) as robot:
         robot.step()
         scan = robot.observe().scan
     assert scan is not None and len(scan.ranges) == 1081
@@ -79,7 +82,7 @@ def test_scan_of_an_empty_room_matches_its_walls_within_noise(
 def test_legs_two_metres_ahead_are_two_short_arcs_where_they_stand(
     two_rooms: Mission, model: str
 ) -> None:
-    with SimRobot(two_rooms, SimOptions(camera=False, laser_model=model)) as robot:
+    with SimRobot(sim_config(two_rooms), SimOptions(camera=False, laser_model=model)) as robot:
         robot.step()
         scan = robot.observe().scan
         legs = robot.people[0].legs()  # dan's two legs (truth)
@@ -112,7 +115,7 @@ def _person_in_view(robot: SimRobot, name: str) -> tuple[int, int]:
 
 
 def test_a_person_behind_a_wall_is_absent_from_scan_and_camera(two_rooms: Mission) -> None:
-    with SimRobot(two_rooms, SimOptions()) as robot:
+    with SimRobot(sim_config(two_rooms)) as robot:
         # eve at (8, 2.6) is 9.6 deg left of the view axis, inside the 58 deg camera and the
         # laser's field of view, but behind the wall at x = 6
         assert _person_in_view(robot, "eve") == (0, 0)
@@ -124,7 +127,7 @@ def test_a_person_behind_a_wall_is_absent_from_scan_and_camera(two_rooms: Missio
 
 
 def test_camera_intrinsics_and_depth_agree_with_the_scene(two_rooms: Mission) -> None:
-    with SimRobot(two_rooms, SimOptions()) as robot:
+    with SimRobot(sim_config(two_rooms)) as robot:
         robot.step()
         frame = robot.observe().rgbd
     assert frame is not None and frame.mask is not None
@@ -147,7 +150,7 @@ def test_camera_intrinsics_and_depth_agree_with_the_scene(two_rooms: Mission) ->
 
 def test_commands_are_clamped_to_the_limits(house: Mission) -> None:
     limits = house.robot
-    with SimRobot(_empty(house), SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(_empty(house)), SimOptions(camera=False)) as robot:
         assert isinstance(robot, Robot)
         start = robot.pose
         robot.command(Twist2D(2.0, 2.0, 5.0))
@@ -164,7 +167,7 @@ def test_commands_are_clamped_to_the_limits(house: Mission) -> None:
 
 
 def test_the_base_stops_at_a_wall_and_counts_one_collision(two_rooms: Mission) -> None:
-    with SimRobot(_empty(two_rooms), SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(_empty(two_rooms)), SimOptions(camera=False)) as robot:
         robot.command(Twist2D(0.0, -0.22, 0.0))  # sideways toward the south wall at y = 0
         for _ in range(100):  # 10 s: 2.2 m of commands for 1.5 m of room
             robot.step()
@@ -181,7 +184,7 @@ def test_the_base_stops_at_a_wall_and_counts_one_collision(two_rooms: Mission) -
 
 
 def test_head_follows_its_pd_controller_within_limits(two_rooms: Mission) -> None:
-    with SimRobot(_empty(two_rooms), SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(_empty(two_rooms)), SimOptions(camera=False)) as robot:
         robot.command(Twist2D(), HeadTarget(pan=1.0, tilt=-3.0))  # tilt beyond its limit
         pans = []
         for _ in range(30):
@@ -196,7 +199,7 @@ def test_head_follows_its_pd_controller_within_limits(two_rooms: Mission) -> Non
 
 def test_navigate_through_doors_succeeds_and_a_goal_in_a_wall_aborts(house: Mission) -> None:
     # without people: they may stand in a door and send the robot the long way round
-    with SimRobot(_empty(house), SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(_empty(house)), SimOptions(camera=False)) as robot:
         robot.navigate(Pose2D(1.5, 7.5, 1.57))  # kitchen -> hall -> office, round the shelf
         path, speeds = [], []
         while robot.nav_status() is NavStatus.ACTIVE and robot.time < 120:
@@ -230,7 +233,7 @@ def test_pose_noise_and_odometry_drift(two_rooms: Mission) -> None:
         }
     )
     for mission, exact in ((_empty(two_rooms), True), (_empty(noisy), False)):
-        with SimRobot(mission, SimOptions(camera=False)) as robot:
+        with SimRobot(sim_config(mission), SimOptions(camera=False)) as robot:
             robot.command(Twist2D(0.04, 0.0, 0.0))
             errors = []
             for _ in range(100):
@@ -256,7 +259,7 @@ def test_pose_noise_and_odometry_drift(two_rooms: Mission) -> None:
 @pytest.mark.slow
 def test_same_seed_same_episode_other_seed_differs(house: Mission) -> None:
     def episode(seed: int) -> tuple:
-        with SimRobot(house, SimOptions(seed=seed)) as robot:
+        with SimRobot(sim_config(house, seed)) as robot:
             robot.navigate(Pose2D(9.0, 2.0))
             out = []
             for _ in range(40):
@@ -279,7 +282,7 @@ def test_same_seed_same_episode_other_seed_differs(house: Mission) -> None:
 
 
 def test_close_stops_the_base_and_is_idempotent(house: Mission) -> None:
-    robot = SimRobot(_empty(house), SimOptions(camera=False))
+    robot = SimRobot(sim_config(_empty(house)), SimOptions(camera=False))
     robot.command(Twist2D(0.2, 0.0, 0.0))
     robot.close()
     assert robot.commanded == Twist2D()

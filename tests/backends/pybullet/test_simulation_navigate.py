@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.navigation import Navigator
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.core.mapping.planning import GridPlanner
@@ -34,7 +35,7 @@ def room() -> Mission:
 
 
 def test_navigate_takes_the_goal_and_the_next_step_plans_it(room: Mission) -> None:
-    with SimRobot(room, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(room), SimOptions(camera=False)) as robot:
         robot.navigate(Pose2D(2.0, 2.0))
         assert robot.nav_status() is NavStatus.ACTIVE
         assert robot.navigator.path is None  # not planned inside navigate

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import shapely
 
-from pfctl.backends.pybullet.walkers import LEG_RADIUS, PERSON_RADIUS, make_walkers
+from pfctl.app.sim import sim_config
+from pfctl.backends.pybullet.walkers import LEG_RADIUS, PERSON_RADIUS, Walker, make_walkers
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
 from pfctl.mission import Mission, ScenarioConfig
@@ -16,8 +17,12 @@ pytestmark = pytest.mark.sim
 DT = 0.05
 
 
+def _make_walkers(mission: Mission, planner: GridPlanner, seed: int) -> list[Walker]:
+    return make_walkers(sim_config(mission).scenario, mission.layout(), planner, seed)
+
+
 def _run(mission: Mission, planner: GridPlanner, seed: int, seconds: float) -> dict:
-    walkers = make_walkers(mission, planner, seed)
+    walkers = _make_walkers(mission, planner, seed)
     log: dict[str, list] = {w.name: [] for w in walkers}
     for _ in range(int(seconds / DT)):
         for w in walkers:
@@ -35,7 +40,7 @@ def test_walkers_follow_routes_through_doors_at_their_speed(
     walls = wall_footprint(layout, mission.map.wall_thickness)
     regions = {r.name: shapely.Polygon(r.polygon) for r in layout.regions}
     people = {p.name: p for p in mission.scenario.people}
-    walkers = {w.name: w for w in make_walkers(mission, planner, 3)}
+    walkers = {w.name: w for w in _make_walkers(mission, planner, 3)}
     assert walkers["alice"].is_target and not walkers["bob"].is_target
     for name, rows in log.items():
         xy = rows[:, :2]
@@ -101,7 +106,7 @@ def test_look_alike_loop_and_random_people(mission: Mission, planner: GridPlanne
     people[2]["clothes"] = people[0]["clothes"]  # carol dressed like the target
     scenario = {**mission.scenario.model_dump(), "people": people, "random_people": 2}
     m = mission.model_copy(update={"scenario": ScenarioConfig.model_validate(scenario)})
-    walkers = make_walkers(m, planner, seed=5)
+    walkers = _make_walkers(m, planner, seed=5)
     names = [w.name for w in walkers]
     assert names[-2:] == ["walker_0", "walker_1"] and len(walkers) == 5
     target = next(w for w in walkers if w.is_target)
@@ -111,5 +116,5 @@ def test_look_alike_loop_and_random_people(mission: Mission, planner: GridPlanne
     for _ in range(int(150 / DT)):
         bob.step(DT)
     assert not bob.done  # a looping person keeps walking
-    again = make_walkers(m, planner, seed=5)
+    again = _make_walkers(m, planner, seed=5)
     assert [w.clothes for w in again] == [w.clothes for w in walkers]

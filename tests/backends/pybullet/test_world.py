@@ -6,6 +6,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from pfctl.app.sim import house_config
 from pfctl.backends.pybullet.laser import FastLaser
 from pfctl.backends.pybullet.world import build_world
 from pfctl.core.robot import Pose2D
@@ -20,7 +21,7 @@ def test_fast_laser_matches_ray_test_batch_in_house() -> None:
     mission = load_mission(HOUSE)
     client = p.connect(p.DIRECT)
     try:
-        world = build_world(client, mission)
+        world = build_world(client, house_config(mission))
         laser = FastLaser(world.scene.segments)
         r0 = mission.layout().regions[0].polygon
         cx, cy = np.mean(np.array(r0), axis=0)

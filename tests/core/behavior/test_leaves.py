@@ -16,6 +16,7 @@ from py_trees.common import Access, Status
 
 from pfctl.app.follower import build_follower
 from pfctl.app.perception import build_perception
+from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
 from pfctl.core.behavior.blackboard import PredictionState, Sighting, new_namespace
 from pfctl.core.behavior.leaves import WaypointSearch
@@ -71,7 +72,7 @@ PREDICT_AND_LOOK = {
 def test_go_to_the_prediction_then_look_around_then_the_prediction_is_used(
     empty_house: Mission,
 ) -> None:
-    with SimRobot(empty_house, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
         follower = _follower(empty_house, robot, PREDICT_AND_LOOK)
         goal = (2.0, 5.0)  # in the hall, from the kitchen through its door
         prediction = PredictionState(0.0, (2.5, 3.5), np.array([goal]), goal, "hall")
@@ -100,7 +101,7 @@ def test_go_to_the_prediction_then_look_around_then_the_prediction_is_used(
 
 
 def test_a_prediction_off_the_map_fails_at_once_and_is_used_up(empty_house: Mission) -> None:
-    with SimRobot(empty_house, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
         follower = _follower(empty_house, robot, PREDICT_AND_LOOK)
         goal = (20.0, 20.0)  # outside the house: no free cell near it
         prediction = PredictionState(0.0, (2.5, 3.5), np.array([goal]), goal, None)
@@ -115,7 +116,7 @@ def test_a_prediction_off_the_map_fails_at_once_and_is_used_up(empty_house: Miss
 
 def test_waypoint_search_explores_toward_the_heading_region(empty_house: Mission) -> None:
     tree = {"action": "waypoint_search"}
-    with SimRobot(empty_house, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
         follower = _follower(empty_house, robot, tree)
         # the target was last seen walking up the hall toward the office door
         t = np.linspace(0.0, 3.0, 31)
@@ -192,7 +193,7 @@ def test_a_visited_frontier_still_there_is_followed_along_not_dropped() -> None:
 
 
 def test_stop_leaf_succeeds_and_close_stops_the_base_twice_safely(empty_house: Mission) -> None:
-    with SimRobot(empty_house, SimOptions(camera=False)) as robot:
+    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
         follower = _follower(empty_house, robot, {"action": "stop"})
         robot.command(Twist2D(0.3, 0.0, 0.0))  # moving when the tree takes over
         records = _run(follower, robot, 0.5)

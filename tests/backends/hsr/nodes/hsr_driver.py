@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 
 import pfctl
+from pfctl.app.hsr import hsr_config
 from pfctl.app.leg_models import load_leg_model
 from pfctl.backends.hsr.robot import HsrRobot
 from pfctl.core.perception.legs.detector import LegDetector
@@ -154,7 +155,7 @@ def navigate(robot: HsrRobot) -> None:
     say("nav", seen=seen)
     robot.close()
     # a second robot in the same process (rospy: one node per process) uses the same node
-    with HsrRobot(robot.mission, node_name="pfctl_test", connect_timeout=15.0) as second:
+    with HsrRobot(robot.config, node_name="pfctl_test", connect_timeout=15.0) as second:
         scan = None
         while scan is None:
             second.step()
@@ -214,7 +215,7 @@ def main() -> None:
     mission = mission.model_copy(update={"backend": BackendConfig(hsr=hsr)})
     started = time.monotonic()
     try:
-        robot = HsrRobot(mission, node_name="pfctl_test", connect_timeout=args.timeout)
+        robot = HsrRobot(hsr_config(mission), node_name="pfctl_test", connect_timeout=args.timeout)
     except UserError as err:
         say(
             "error",

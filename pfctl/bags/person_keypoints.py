@@ -3,7 +3,9 @@
 The paper ran OpenPose on a machine beside the HSR and placed each person it found in 3-D with
 the depth image (§II-E). The HSR backend takes such detections, when the mission sets
 ``backend.hsr.person_keypoints``, from a ``sensor_msgs/PointCloud`` topic — a standard message,
-so that no custom message has to be built on the robot or here:
+so that no custom message has to be built on the robot or here. The format lives with the bags
+because two sides read it: the HSR backend on the wire, :mod:`pfctl.bags.replay` in a recorded
+bag. A message holds:
 
 ``header.stamp``
     The stamp of the RGB image the detector ran on (the backend pairs it with the RGB, depth
