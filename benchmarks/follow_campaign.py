@@ -10,8 +10,8 @@ Run::
 For every mission (default: ``missions/house.yaml``, ``missions/house_no_prediction.yaml``
 and ``missions/house_no_waypoint_search.yaml``: the paper's episode and its two ablations) and
 every seed (``--seeds N`` seeds from ``--first-seed``, default 20 seeds 1..20), one episode of
-``pfctl bench`` runs (:func:`pfctl.bench.episode.run_episode_task`): learn the target's profile in
-the simulator *with that seed* (the faces depend on the seed), run the follower for
+``pfctl bench`` runs (:func:`pfctl.app.campaign.run_campaign_episode`): learn the target's
+profile in the simulator *with that seed* (the faces depend on the seed), run the follower for
 ``--duration`` simulated seconds (default 120) and return the episode's
 :func:`~pfctl.core.metrics.follow_metrics`. ``--jobs`` workers (default: the number of
 CPUs) run at once (:func:`pfctl.bench.runner.run_in_processes`): a fresh process per episode,
@@ -358,6 +358,7 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     timeout = max(600.0, 10 * args.duration) if args.timeout is None else args.timeout
 
+    from pfctl.app.campaign import run_campaign_episode
     from pfctl.bench.runner import WorkerDiedError, run_in_processes
     from pfctl.commands.bench import build_campaign
 
@@ -404,7 +405,7 @@ def main(argv: list[str] | None = None) -> int:
             print(_progress_line(len(rows), len(specs), row), flush=True)
 
         try:
-            run_in_processes(specs, jobs, on_record)
+            run_in_processes(specs, jobs, on_record, run_campaign_episode)
         except (KeyboardInterrupt, WorkerDiedError) as err:
             what = "interrupted" if isinstance(err, KeyboardInterrupt) else str(err)
             print(f"{what}: {len(specs) - len(rows)} episodes not run", file=sys.stderr)

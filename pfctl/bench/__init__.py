@@ -6,8 +6,9 @@ One concept per module:
   data, their cross product, readable variant names;
 - :mod:`~pfctl.bench.plan`: the campaign — which episodes (mission file, variant, seed) to run,
   and the fingerprint of its configuration;
-- :mod:`~pfctl.bench.episode`: one episode as a task a worker runs (learn the target with the
-  episode's seed, follow or search headless, return a JSON-able record);
+- :mod:`~pfctl.bench.episode`: one episode as a task a worker runs: the episode function the app
+  gives (:mod:`pfctl.app.campaign`: learn the target with the episode's seed, follow or search
+  headless, measure) wrapped into a JSON-able record;
 - :mod:`~pfctl.bench.runner`: running the tasks in spawned worker processes or as Ray tasks;
 - :mod:`~pfctl.bench.results`: the results file (JSON lines, one per finished episode, synced as
   each ends) and resuming from it;

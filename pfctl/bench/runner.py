@@ -1,6 +1,7 @@
 """Running campaign episodes: local worker processes, or Ray tasks on a cluster.
 
-Both run the same task, :func:`pfctl.bench.episode.run_episode_task`, and hand each record to
+Both run the same task, :func:`pfctl.bench.episode.run_episode_task` with the ``episode`` function
+the caller gives (:func:`pfctl.app.campaign.run_campaign_episode`), and hand each record to
 ``on_record`` in the calling thread as the episode finishes (in finishing order). Neither
 schedules anything itself:
 
@@ -28,7 +29,7 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from concurrent.futures.process import BrokenProcessPool
 from typing import Any
 
-from pfctl.bench.episode import error_record, one_blas_thread, run_episode_task
+from pfctl.bench.episode import Episode, error_record, one_blas_thread, run_episode_task
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.errors import UserError
 
@@ -64,8 +65,11 @@ def _terminate(pool: ProcessPoolExecutor) -> None:
             process.join()
 
 
-def run_in_processes(specs: Sequence[EpisodeSpec], workers: int, on_record: OnRecord) -> None:
-    """Run ``specs`` in at most ``workers`` spawned processes (module docstring).
+def run_in_processes(
+    specs: Sequence[EpisodeSpec], workers: int, on_record: OnRecord, episode: Episode
+) -> None:
+    """Run ``specs`` with ``episode`` in at most ``workers`` spawned processes (module
+    docstring).
 
     Raises:
         WorkerDiedError: a worker process died; the unfinished episodes were not recorded.
@@ -81,7 +85,7 @@ def run_in_processes(specs: Sequence[EpisodeSpec], workers: int, on_record: OnRe
     )
     try:
         running: dict[Future[dict[str, Any]], EpisodeSpec] = {
-            pool.submit(run_episode_task, spec): spec for spec in specs
+            pool.submit(run_episode_task, spec, episode): spec for spec in specs
         }
         while running:
             done, _ = wait(running, timeout=1.0, return_when=FIRST_COMPLETED)
@@ -111,7 +115,11 @@ def ray_available() -> bool:
 
 
 def run_on_ray(
-    specs: Sequence[EpisodeSpec], address: str, workers: int, on_record: OnRecord
+    specs: Sequence[EpisodeSpec],
+    address: str,
+    workers: int,
+    on_record: OnRecord,
+    episode: Episode,
 ) -> None:
     """Run ``specs`` as Ray tasks on the cluster at ``address`` (module docstring).
 
@@ -137,7 +145,7 @@ def run_on_ray(
             raise UserError(f"--ray {address}: cannot start or reach Ray: {message}") from None
     try:
         task = ray.remote(num_cpus=1, max_retries=0)(run_episode_task)
-        refs = {task.remote(spec): spec for spec in specs}
+        refs = {task.remote(spec, episode): spec for spec in specs}
         pending = list(refs)
         try:
             while pending:

@@ -29,6 +29,7 @@ from typing import Annotated, Any
 import typer
 from rich.console import Console
 
+from pfctl.app.campaign import run_campaign_episode
 from pfctl.bench.aggregate import metrics_for, summarize
 from pfctl.bench.episode import BLAS_THREAD_VARIABLES
 from pfctl.bench.plan import TASKS, Campaign, MissionVariant, load_variant, mission_digest
@@ -227,9 +228,9 @@ def bench(
                 console.print(_episode_line(record, done, total), highlight=False)
 
             if ray is not None:
-                run_on_ray(todo, ray, jobs, on_record)
+                run_on_ray(todo, ray, jobs, on_record, run_campaign_episode)
             else:
-                run_in_processes(todo, jobs, on_record)
+                run_in_processes(todo, jobs, on_record, run_campaign_episode)
     except KeyboardInterrupt:
         interrupted = True
     except WorkerDiedError as err:

@@ -70,6 +70,7 @@ class FakeRunner:
         specs: Sequence[EpisodeSpec],
         workers: int,
         on_record: Callable[[dict[str, Any]], None],
+        episode: Callable[[EpisodeSpec], Any],
     ) -> None:
         calls.append([s.key for s in specs])
         for i, spec in enumerate(specs):
