@@ -13,12 +13,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from pfctl.app.memory import retain_freed_memory
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.control import ControlParams
 from pfctl.core.episode import EpisodeLog, TickRecord
 from pfctl.core.follower import Follower, FollowerParams, PredictionParams
 from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
-from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.regions import RegionMap, SearchParams
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.models import SvrState
@@ -64,8 +63,8 @@ def build_follower(
     """The mission's follower on ``robot`` with ``perception``."""
     grid = static_map(mission)
     regions = RegionMap(mission.layout())
-    # cached per geometry (~10 ms): made here, not in the tick of the first prediction or
-    # Algorithm 1 (both block the region map's walls on this map's grid)
+    # cached per geometry: made here, not in the tick of the first prediction or Algorithm 1
+    # (both block the region map's walls on this map's grid)
     regions.blocked_mask(grid.geometry)
     return Follower(
         robot,

@@ -57,7 +57,6 @@ from pfctl.core.behavior.intents import (
     Velocity,
 )
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS, leaf_factory
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.behavior.tree import build_tree
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import (
@@ -71,7 +70,7 @@ from pfctl.core.control import (
 from pfctl.core.episode import EpisodeLog, PredictionRecord, TickRecord, WaypointRecord
 from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap, WaypointDecision
+from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
 from pfctl.core.params import param
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.clipping import clip_prediction

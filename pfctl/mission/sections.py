@@ -19,10 +19,10 @@ from typing import Annotated, Literal
 import shapely
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.control import ControlParams
 from pfctl.core.follower import FollowerParams, PredictionParams
 from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region
+from pfctl.core.mapping.regions import SearchParams
 from pfctl.core.metrics import MetricParams
 from pfctl.core.perception.belief import BeliefParams
 from pfctl.core.perception.clothes import ClothesParams

@@ -13,10 +13,10 @@ from pydantic import BaseModel, Field
 
 from pfctl.app.follower import control_params, follower_params
 from pfctl.app.perception import belief_params, identity_params, leg_params, tracker_params
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.control import ControlParams
 from pfctl.core.follower import FollowerParams, PredictionParams
 from pfctl.core.mapping.grid import InverseSensorModel
+from pfctl.core.mapping.regions import SearchParams
 from pfctl.core.metrics import MetricParams
 from pfctl.core.params import param, param_info
 from pfctl.core.perception.belief import BeliefParams

@@ -13,10 +13,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap, WaypointDecision, waypoint_search
+from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, waypoint_search
 
 #: Cells at least this likely occupied block the line of sight (the grid's occupied threshold).
 _OCCUPIED_LOGODDS = float(logit(OCCUPIED_THRESH))

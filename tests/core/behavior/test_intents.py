@@ -16,13 +16,12 @@ from pfctl.core.behavior.intents import (
     Stop,
     Velocity,
 )
-from pfctl.core.behavior.skills import SearchParams
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import ControlParams
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.regions import RegionMap, SearchParams
 from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
 
 HALL = Pose2D(3.9, 4.5, 0.0)  # free floor in the hall of missions/house.yaml

@@ -33,7 +33,8 @@ class IdentityParams:
     """Look for faces at all (False: clothes only, e.g. without dlib's models)."""
     face_settled: int = 3
     """A track with this many face samples is settled: its face is looked at again only every
-    ``face_recheck_s`` (an embedding costs ~90 ms on one core; see benchmarks/bench_identity)."""
+    ``face_recheck_s`` (an embedding is the costliest step of Algorithm 2;
+    benchmarks/bench_identity.py measures it)."""
     face_recheck_s: float = 1.0
     """How often a settled track's face is embedded again, seconds."""
     face_miss_limit: int = param(
