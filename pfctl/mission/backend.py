@@ -32,7 +32,7 @@ class HsrConfig(MissionModel):
       2 torso, 3 leg).
     * ``person_keypoints`` (when set; then ``person_labels`` is not subscribed and must be left
       out or null): 2-D keypoints and boxes as a ``sensor_msgs/PointCloud``
-      (:mod:`pfctl.backends.hsr.person_keypoints`): ``header.stamp`` = the stamp of the RGB image
+      (:mod:`pfctl.bags.person_keypoints`): ``header.stamp`` = the stamp of the RGB image
       the detector ran on (paired with RGB, depth and camera_info like the labels),
       ``header.frame_id`` = the RGB optical frame; one point per keypoint, ``x`` = pixel column,
       ``y`` = pixel row, ``z`` = confidence (≤ 0: not found); channels ``person`` (an index
