@@ -18,7 +18,6 @@ import numpy as np
 from rich.console import Console
 
 from pfctl.app.episodes import hide_target, metric_params, run_sim_episode, target_profile
-from pfctl.app.sim import sim_robot
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.core.metrics import follow_metrics, search_metrics
 
@@ -29,6 +28,8 @@ HOW = ("prediction", "waypoint_search", "other")
 def run_campaign_episode(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[str, Any]]:
     """The episode of ``spec`` (module docstring): its status (``ok``, or ``timeout`` when the
     spec's wall-clock limit ended it), metrics and timing."""
+    from pfctl.app.sim import sim_robot  # loads PyBullet: in the worker, not when the CLI starts
+
     mission = spec.mission
     source = f"{spec.mission_file} [{spec.variant}]"
     start = time.perf_counter()
