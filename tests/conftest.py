@@ -45,3 +45,13 @@ def run_cli(
     captured = capsys.readouterr()
     code = exited.value.code
     return (code if isinstance(code, int) else 0 if code is None else 1), captured.out, captured.err
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Every test of the HSR backend needs ROS 1: one without the ``ros`` marker would run in the
+    quick loop (``-m "not slow and not ros"``) and fail or skip there."""
+    for item in items:
+        if item.nodeid.startswith("tests/backends/hsr/") and item.get_closest_marker("ros") is None:
+            raise pytest.UsageError(
+                f"{item.nodeid}: a test of the HSR backend without the ros marker"
+            )

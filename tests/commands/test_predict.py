@@ -165,6 +165,7 @@ def test_bad_options_exit_2(
     assert_one_error_line(err, "--horizon")
 
 
+@pytest.mark.slow
 def test_real_process_contract(tmp_path: Path) -> None:
     """The console script for real: exit 2 and one line, no traceback."""
     bad = tmp_path / "bad.csv"

@@ -75,6 +75,7 @@ def test_search_finds_the_target_in_the_hall_and_writes_its_files(tmp_path: Path
         (["--duration", "0"], "--duration"),
     ],
 )
+@pytest.mark.slow
 def test_bad_search_options_are_one_line_and_exit_2(
     tmp_path: Path, args: list[str], expected: str
 ) -> None:

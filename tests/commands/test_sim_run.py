@@ -61,6 +61,7 @@ def test_the_picture_goes_where_asked_and_the_camera_runs(tmp_path: Path) -> Non
     assert out.read_bytes()[:8] == PNG
 
 
+@pytest.mark.slow
 def test_bad_input_is_one_line_and_exit_2(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

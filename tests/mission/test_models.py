@@ -558,6 +558,7 @@ def test_subprocess_contract_for_a_broken_and_a_missing_mission(tmp_path: Path) 
     assert_one_error_line(result.stderr, "pfctl: error: missing.yaml: no such file")
 
 
+@pytest.mark.slow
 def test_subprocess_validates_the_shipped_mission() -> None:
     result = run_subprocess(["mission", "validate", "missions/house.yaml"], cwd=ROOT)
     assert result.returncode == 0, result.stderr

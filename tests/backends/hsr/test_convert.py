@@ -20,9 +20,7 @@ from pfctl.core.robot import (
     Twist2D,
 )
 
-pytestmark = pytest.mark.ros
-
-pytestmark = pytest.mark.usefixtures("ros")
+pytestmark = [pytest.mark.ros, pytest.mark.usefixtures("ros")]
 
 
 def wire(msg):

@@ -29,9 +29,7 @@ from tests.backends.hsr.conftest import RosMaster
 from tests.backends.hsr.test_robot import Output
 from tests.backends.hsr.test_sim_bridge import HOUSE, PFCTL, finish_bridge, wait_serving
 
-pytestmark = [pytest.mark.ros, pytest.mark.sim]
-
-pytestmark = pytest.mark.usefixtures("ros")
+pytestmark = [pytest.mark.ros, pytest.mark.sim, pytest.mark.usefixtures("ros")]
 
 NODES = Path(__file__).parent / "nodes"
 TOPIC = "/pfctl/person_keypoints"

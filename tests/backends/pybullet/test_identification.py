@@ -150,6 +150,7 @@ def test_algorithm2_picks_the_target_among_look_alikes_and_keeps_it_when_backs_t
         assert final[alice].basis == "face" and final[alice].face_samples == 2
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("size", [(320, 240), (640, 480)])
 def test_mask_detector_places_people_within_15cm_of_the_truth(size: tuple[int, int]) -> None:
     with SimRobot(sim_config(_scene(*size))) as robot:
