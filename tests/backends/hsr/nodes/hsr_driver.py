@@ -57,7 +57,8 @@ def observe(robot: HsrRobot) -> None:
         times.append(robot.time)
         obs = robot.observe()
         assert obs.stamp >= times[-1] - 1e-9, (obs.stamp, times[-1])
-        if obs.scan is not None and scan is None:
+        # the fake HSR's topics arrive in any order: the first scan seen with the odometry too
+        if obs.scan is not None and obs.odometry is not None and scan is None:
             scan, scan_obs = obs.scan, obs
         if obs.rgbd is not None and frame is None:
             frame = obs.rgbd
