@@ -65,7 +65,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from pfctl.core.episode import HAS_TARGET, EpisodeLog
+from pfctl.core.episode import HAS_TARGET, EpisodeLog, tick_columns, truth_columns
 from pfctl.core.params import param
 
 FloatArray = NDArray[np.float64]
@@ -251,24 +251,28 @@ def _check_lengths(log: EpisodeLog) -> bool:
 
 def _people_arrays(log: EpisodeLog) -> tuple[FloatArray, FloatArray, FloatArray]:
     """Robot ``(n, 2)``, target ``(n, 2)`` and the other people ``(n, P, 2)`` (NaN-padded)."""
-    n = len(log.truths)
-    robot = np.array([(g.robot.x, g.robot.y) for g in log.truths], dtype=float).reshape(n, 2)
-    width = max(1, max((len(g.people) for g in log.truths), default=0))
+    columns = truth_columns(log.truths)
+    n = len(columns.people)
+    width = max(1, max((len(people) for people in columns.people), default=0))
     name = log.target_name
     nan2 = (math.nan, math.nan)
     target: list[tuple[float, float]] = []
     others: list[list[tuple[float, float]]] = []
-    for g in log.truths:
+    for people in columns.people:
         mine = nan2
         rest = []
-        for p in g.people:
-            if mine is nan2 and (p.is_target or (name is not None and p.name == name)):
-                mine = (p.x, p.y)
+        for who, x, y, is_target in people:
+            if mine is nan2 and (is_target or (name is not None and who == name)):
+                mine = (x, y)
             else:
-                rest.append((p.x, p.y))
+                rest.append((x, y))
         target.append(mine)
         others.append(rest + [nan2] * (width - len(rest)))
-    return robot, np.array(target, dtype=float).reshape(n, 2), np.array(others, dtype=float)
+    return (
+        columns.robot_xy.reshape(n, 2),
+        np.array(target, dtype=float).reshape(n, 2),
+        np.array(others, dtype=float),
+    )
 
 
 def episode_arrays(log: EpisodeLog, params: MetricParams | None = None) -> EpisodeArrays:
@@ -277,15 +281,12 @@ def episode_arrays(log: EpisodeLog, params: MetricParams | None = None) -> Episo
     ValueError when truths are recorded but not one per tick.
     """
     params = params or MetricParams()
-    ticks = log.ticks
-    n = len(ticks)
-    t = np.fromiter((k.t for k in ticks), dtype=float, count=n)
-    has = np.fromiter((k.awareness in HAS_TARGET for k in ticks), dtype=bool, count=n)
-    nan2 = (math.nan, math.nan)
-    target_xy = np.array(
-        [k.target_xy if k.target_xy is not None else nan2 for k in ticks], dtype=float
-    ).reshape(n, 2)
-    pose_xy = np.array([(k.pose.x, k.pose.y) for k in ticks], dtype=float).reshape(n, 2)
+    ticks = tick_columns(log.ticks)
+    n = len(ticks.t)
+    t = ticks.t
+    has = np.fromiter((a in HAS_TARGET for a in ticks.awareness), dtype=bool, count=n)
+    target_xy = ticks.target_xy
+    pose_xy = ticks.pose_xy
     period = float(np.median(np.diff(t))) if n >= 2 else 0.0
     estimated = np.hypot(*(target_xy - pose_xy).T) if n else np.zeros(0)
     has_truth = _check_lengths(log)
@@ -347,7 +348,7 @@ def _search_codes(log: EpisodeLog) -> NDArray[np.int8]:
     """Per tick: 1 for a prediction action, 2 for way-point search, 0 otherwise."""
     codes = {a: 1 for a in PREDICTION_ACTIONS} | {a: 2 for a in WAYPOINT_ACTIONS}
     return np.fromiter(
-        (codes.get(k.action, 0) if k.action else 0 for k in log.ticks),
+        (codes.get(a, 0) if a else 0 for a in tick_columns(log.ticks).action),
         dtype=np.int8,
         count=len(log.ticks),
     )
