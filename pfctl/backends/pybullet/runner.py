@@ -19,6 +19,8 @@ from typing import Protocol
 from pfctl.backends.pybullet.drivers import KeyboardDriver, ScriptStep
 from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.bags.recording import EpisodeRecorder
+from pfctl.core.episode import GroundTruthCodec
+from pfctl.core.packed_records import PackedRecords, packed_factory
 from pfctl.core.robot import STOP, GroundTruth
 
 
@@ -32,9 +34,10 @@ class Driver(Protocol):
 
 @dataclass
 class RunResult:
-    """What a run did: the truth at every control period and a few counts."""
+    """What a run did: the truth at every control period (packed, so that hours of it stay
+    small: :class:`~pfctl.core.episode.GroundTruthCodec`) and a few counts."""
 
-    truths: list[GroundTruth] = field(default_factory=list)
+    truths: PackedRecords[GroundTruth] = field(default_factory=packed_factory(GroundTruthCodec))
     sim_time: float = 0.0
     wall_time: float = 0.0
     scans: int = 0
