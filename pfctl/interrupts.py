@@ -105,7 +105,7 @@ class _Signals:
             flag.set = True
         elif len(self.received) < ABANDON_AFTER:
             sys.stderr.write(
-                f"{signal_name(signum)} again: still stopping and writing what was measured "
+                f"{signal_name(signum)}: still stopping and writing what was measured "
                 "(a third signal abandons the writing)\n"
             )
             sys.stderr.flush()

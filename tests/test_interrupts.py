@@ -33,7 +33,7 @@ def test_in_a_run_the_first_stops_the_second_is_acknowledged_the_third_abandons(
             assert stop() and stop.signum == signal.SIGTERM
         _kill(signal.SIGINT)  # after the run, while writing: still no exception
         err = capsys.readouterr().err
-        assert err.count("\n") == 1 and err.startswith("SIGINT again: still stopping")
+        assert err.count("\n") == 1 and err.startswith("SIGINT: still stopping")
         with pytest.raises(Interrupted) as raised:
             _kill(signal.SIGINT)
     assert raised.value.signum == signal.SIGTERM and raised.value.exit_status == 143
