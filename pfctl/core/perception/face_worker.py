@@ -27,9 +27,9 @@ process instead:
   GIL), widened on Linux so that a few crops never make :meth:`submit` wait for the child;
 - :meth:`close` (or leaving the ``with`` block) stops the child and reaps it; a worker that is
   garbage-collected or still open at interpreter exit is stopped too. The child ignores Ctrl-C
-  (the parent decides when to stop) and exits by itself when its parent has died (the job pipe
-  reaches its end; it finishes the job at hand first). A child that dies is reported as one
-  line (:class:`FaceWorkerError`) by the next call.
+  and SIGTERM (the parent decides when to stop) and exits by itself when its parent has died
+  (the job pipe reaches its end; it finishes the job at hand first). A child that dies is
+  reported as one line (:class:`FaceWorkerError`) by the next call.
 
 One worker serves one :class:`~pfctl.core.perception.identity.identifier.TargetIdentifier` at a time
 (its job keys are unique; an identifier ignores the results of jobs that are not its own).
