@@ -265,7 +265,9 @@ class HsrRobot:
         try:
             self._setup(actionlib)
             self._connect(timeout)
-        except BaseException:
+        except BaseException as err:
+            if isinstance(err, Interrupted) and err.during is None:
+                err.during = f"while connecting to the HSR (ROS_MASTER_URI={self.master_uri})"
             self._release()
             raise
         self._opened = True
