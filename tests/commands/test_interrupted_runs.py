@@ -66,6 +66,14 @@ class _Command:
                 return
             self._stderr.extend(chunk)
 
+    def wait_for_text(self, text: bytes) -> None:
+        """Until ``text`` appears on stderr."""
+        deadline = time.monotonic() + TIMEOUT
+        while text not in bytes(self._stderr):
+            assert self.process.poll() is None, self.finish()
+            assert time.monotonic() < deadline, f"no {text!r}: {self.finish()}"
+            time.sleep(0.05)
+
     def wait_for_episode(self, simulated: float = 1.0) -> None:
         """Until the progress bar shows ``simulated`` seconds of the episode."""
         deadline = time.monotonic() + TIMEOUT
@@ -190,3 +198,19 @@ def test_sim_run_writes_what_was_measured(tmp_path: Path, signals: tuple[int, ..
     assert png.read_bytes()[:8] == PNG
     assert json.loads((episode / "episode.json").read_text())
     assert stdout.startswith("interrupted after")
+
+
+def test_sigterm_while_learning_the_target_ends_follow_at_once(tmp_path: Path) -> None:
+    """Before the episode (here: learning the target) SIGTERM ends the command at once with one
+    line and 143; nothing is written."""
+    out = tmp_path / "follow"
+    command = _Command("follow", str(HOUSE), "--seed", "1", "--duration", "60", "--out", str(out))
+    command.wait_for_text(b"learning the target")
+    command.signal(signal.SIGTERM)
+    code, stdout, err = command.finish()
+    assert code == 143, err
+    assert "Traceback" not in err
+    assert [line for line in err.splitlines() if line.startswith("pfctl:")] == [
+        "pfctl: interrupted (SIGTERM)"
+    ]
+    assert stdout == "" and not out.exists()
