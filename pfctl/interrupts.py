@@ -17,6 +17,7 @@ line saying what was written and the exit status of the first signal.
 from __future__ import annotations
 
 import contextlib
+import os
 import signal
 import sys
 import threading
@@ -104,11 +105,16 @@ class _Signals:
             flag.signum = signum
             flag.set = True
         elif len(self.received) < ABANDON_AFTER:
-            sys.stderr.write(
+            line = (
                 f"{signal_name(signum)}: still stopping and writing what was measured "
                 "(a third signal abandons the writing)\n"
             )
-            sys.stderr.flush()
+            # straight to the descriptor: the handler may run inside a write to sys.stderr,
+            # whose buffer refuses a reentrant call
+            try:
+                os.write(sys.stderr.fileno(), line.encode())
+            except (OSError, ValueError):  # no descriptor (captured): as usual
+                sys.stderr.write(line)
         else:
             self.raise_now(self.received[0], "three times: abandoned writing the outputs")
 

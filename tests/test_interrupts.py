@@ -24,7 +24,7 @@ def test_before_a_run_a_signal_ends_the_command_at_once(signum: int, status: int
 
 
 def test_in_a_run_the_first_stops_the_second_is_acknowledged_the_third_abandons(
-    capsys: pytest.CaptureFixture[str],
+    capfd: pytest.CaptureFixture[str],
 ) -> None:
     with command_signals():
         with graceful_interrupts() as stop:
@@ -32,7 +32,7 @@ def test_in_a_run_the_first_stops_the_second_is_acknowledged_the_third_abandons(
             _kill(signal.SIGTERM)
             assert stop() and stop.signum == signal.SIGTERM
         _kill(signal.SIGINT)  # after the run, while writing: still no exception
-        err = capsys.readouterr().err
+        err = capfd.readouterr().err
         assert err.count("\n") == 1 and err.startswith("SIGINT: still stopping")
         with pytest.raises(Interrupted) as raised:
             _kill(signal.SIGINT)
