@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import sys
 
 import typer
@@ -18,6 +19,7 @@ from pfctl.commands import predict as predict_commands
 from pfctl.commands import replay as replay_command
 from pfctl.commands import sim as sim_commands
 from pfctl.errors import UserError
+from pfctl.interrupts import Interrupted, command_signals, unreported
 
 app = typer.Typer(
     name="pfctl",
@@ -57,15 +59,22 @@ def _root(
 
 
 def main() -> None:
-    """Console entry point: user errors become one line on stderr and exit status 2."""
-    try:
-        app()
-    except UserError as err:
-        sys.stderr.write(f"pfctl: error: {err}\n")
-        sys.exit(err.exit_code)
-    except KeyboardInterrupt:
-        sys.stderr.write("pfctl: interrupted\n")
-        sys.exit(130)
+    """Console entry point: user errors become one line on stderr and exit status 2; SIGINT and
+    SIGTERM (:mod:`pfctl.interrupts`) one line and exit status 130 or 143."""
+    with command_signals():
+        try:
+            app()
+        except UserError as err:
+            sys.stderr.write(f"pfctl: error: {err}\n")
+            sys.exit(err.exit_code)
+        except (KeyboardInterrupt, SystemExit) as end:
+            interrupt = unreported(end)
+            if interrupt is None:
+                if isinstance(end, SystemExit):
+                    raise
+                interrupt = Interrupted(signal.SIGINT)
+            sys.stderr.write(interrupt.line())
+            sys.exit(interrupt.exit_status)
 
 
 if __name__ == "__main__":  # pragma: no cover

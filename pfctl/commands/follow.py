@@ -23,7 +23,8 @@ distances are the robot's own beliefs (:mod:`pfctl.core.metrics`). A robot that 
 answering (stale laser or pose, lost master) has its base stopped and ends the run: the outputs of
 what was measured are written and the command exits 1 with one line saying what was lost.
 
-Both stop the base on every exit; the first Ctrl-C ends the episode and keeps what was measured.
+Both stop the base on every exit; the first Ctrl-C or SIGTERM ends the episode, what was measured
+is written, and the command exits 130 or 143 with one line (:mod:`pfctl.interrupts`).
 """
 
 from __future__ import annotations
@@ -61,7 +62,7 @@ from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
 from pfctl.files import atomic_write_all, check_episode_dir
-from pfctl.interrupts import graceful_interrupts
+from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
 if TYPE_CHECKING:
@@ -172,7 +173,7 @@ def follow(
     console = Console(stderr=True)
     profile = target_profile(loaded, target, seed, console, str(mission))
     if backend == "hsr":
-        result, seed_used = _run_hsr(loaded, profile, duration, console, "following"), None
+        (result, stop), seed_used = _run_hsr(loaded, profile, duration, console, "following"), None
     else:
         robot = _sim_robot(loaded, seed, gui, str(mission))
         seed_used = robot.seed
@@ -207,7 +208,7 @@ def follow(
     ]
     written = _write(out, files)
     _follow_report(metrics, result, written)
-    _end(result)
+    _end(result, stop, out)
 
 
 def _sim_robot(mission: Mission, seed: int | None, gui: bool, source: str) -> SimRobot:
@@ -226,9 +227,10 @@ def _run_hsr(
     what: str,
     *,
     until_found: bool = False,
-) -> EpisodeResult:
+) -> tuple[EpisodeResult, StopFlag]:
     """The follower on the HSR over ROS 1 (``backend.hsr``) for ``duration`` s of ROS time; the
-    simulator's truth is recorded for the metrics when ``pfctl sim serve-hsr`` publishes it."""
+    simulator's truth is recorded for the metrics when ``pfctl sim serve-hsr`` publishes it.
+    Connecting is not part of the run: a signal while waiting for the robot ends the command."""
     from pfctl.app.hsr import hsr_config
     from pfctl.backends.hsr.robot import HsrRobot
 
@@ -251,15 +253,16 @@ def _run_hsr(
                 until_found=until_found,
             )
     result.clock_origin = robot.clock_origin
-    return result
+    return result, stop
 
 
-def _end(result: EpisodeResult) -> None:
-    """Exit 1 with one line when the robot was lost, 130 when interrupted (the outputs of what
-    was measured are written first)."""
+def _end(result: EpisodeResult, stop: StopFlag, out: Path) -> None:
+    """Exit 1 with one line when the robot was lost, 130 (SIGINT) or 143 (SIGTERM) with one line
+    when interrupted (the outputs of what was measured are written first)."""
     if result.lost is not None:
         sys.stderr.write(f"pfctl: error: {result.lost}; the base was stopped\n")
         raise typer.Exit(1)
+    stop.exit_if_set(f"after {result.sim_time:.1f} s of the episode; wrote {out}")
     if result.interrupted:
         raise typer.Exit(130)
 
@@ -366,7 +369,7 @@ def search(
     hidden_in: str | None = None
     seed_used: int | None = None
     if backend == "hsr":
-        result = _run_hsr(loaded, profile, duration, console, "searching", until_found=True)
+        result, stop = _run_hsr(loaded, profile, duration, console, "searching", until_found=True)
     else:
         robot = _sim_robot(loaded, seed, gui, str(mission))
         seed_used = robot.seed
@@ -392,7 +395,7 @@ def search(
     ]
     written = _write(out, files)
     _search_report(metrics, result, written)
-    _end(result)
+    _end(result, stop, out)
 
 
 def _search_report(metrics: SearchMetrics, result: EpisodeResult, written: list[Path]) -> None:

@@ -16,13 +16,11 @@ atomically.
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import math
 import os
-import signal
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -174,7 +172,9 @@ def run(
             title=title,
         )
     _report(loaded, result, robot.collisions, picture, record)
-    if result.interrupted:
+    wrote = f"the episode to {record}/ and {picture}" if record is not None else str(picture)
+    stop.exit_if_set(f"after {result.sim_time:.1f} s simulated; wrote {wrote}")
+    if result.interrupted:  # the quit key
         raise typer.Exit(130)
 
 
@@ -337,38 +337,23 @@ def serve_hsr(
     if hide is not None and hide not in regions:
         raise UserError(f"--hide {hide}: unknown region (regions: {', '.join(regions)})")
     console = Console(stderr=True)
-    with graceful_interrupts() as stop, _terminate_sets(stop):
-        stats = _serve(
-            loaded,
-            mission,
-            seed,
-            duration,
-            rate,
-            depth_encoding,
-            hide,
-            pose_target,
-            wait_for_command,
-            stop,
-            console,
-        )
+    stats, stop = _serve(
+        loaded,
+        mission,
+        seed,
+        duration,
+        rate,
+        depth_encoding,
+        hide,
+        pose_target,
+        wait_for_command,
+        console,
+    )
     _serve_report(stats)
     if stats.lost is not None:
         sys.stderr.write(f"pfctl: error: {stats.lost}\n")
         raise typer.Exit(1)
-
-
-@contextlib.contextmanager
-def _terminate_sets(flag: StopFlag) -> Iterator[None]:
-    """While open, SIGTERM sets ``flag`` (as the first Ctrl-C does) instead of killing."""
-
-    def handler(signum: int, frame: object) -> None:
-        flag.set = True
-
-    previous = signal.signal(signal.SIGTERM, handler)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    stop.exit_if_set(f"after serving {stats.sim_time:.1f} s simulated")
 
 
 def _serve(
@@ -381,9 +366,10 @@ def _serve(
     hide: str | None,
     pose_target: bool,
     wait_for_command: bool,
-    stop: StopFlag,
     console: Console,
-) -> BridgeStats:
+) -> tuple[BridgeStats, StopFlag]:
+    """Serve until ``duration``, Ctrl-C or SIGTERM; the run (:func:`graceful_interrupts`) opens
+    once the bridge is up: a signal while loading or reaching the master ends the command."""
     from pfctl.backends.hsr.ros_import import import_rospy
     from pfctl.backends.hsr.sim_bridge import (
         CLOCK_OFFSET,
@@ -436,12 +422,11 @@ def _serve(
                 soft_wrap=True,
             )
 
+        stop = StopFlag()
         try:
-            if stop():
-                return bridge.stats
             bridge.start()
-            with _ServeProgress(console, duration) as tick:
-                return bridge.run(
+            with graceful_interrupts() as stop, _ServeProgress(console, duration) as tick:
+                stats = bridge.run(
                     duration,
                     stop,
                     on_period=tick,
@@ -449,6 +434,7 @@ def _serve(
                     on_ready=ready,
                     on_release=released,
                 )
+            return stats, stop
         finally:
             bridge.shutdown("interrupted" if stop() else "done")
 

@@ -75,6 +75,7 @@ from pfctl.core.robot import (
 )
 from pfctl.core.tf_buffer import quaternion_matrix
 from pfctl.errors import UserError
+from pfctl.interrupts import Interrupted
 
 MASTER_CHECK_TIMEOUT = 2.0
 """Wall seconds the ROS master may take to answer at start."""
@@ -111,6 +112,9 @@ def _connect_master(uri: str) -> None:
     :data:`MASTER_CHECK_TIMEOUT` seconds (rospy would block forever in ``init_node``)."""
     try:
         check_master(uri, "/pfctl_check", MASTER_CHECK_TIMEOUT)
+    except Interrupted as err:
+        err.during = f"while waiting for the ROS master at {uri}"
+        raise
     except MasterError as err:
         if err.error is None:
             raise RobotConnectionError(f"the ROS master at {uri} answered: {err.answer}") from None
@@ -261,7 +265,9 @@ class HsrRobot:
         try:
             self._setup(actionlib)
             self._connect(timeout)
-        except BaseException:
+        except BaseException as err:
+            if isinstance(err, Interrupted) and err.during is None:
+                err.during = f"while connecting to the HSR (ROS_MASTER_URI={self.master_uri})"
             self._release()
             raise
         self._opened = True
@@ -494,27 +500,36 @@ class HsrRobot:
         deadline = time.monotonic() + timeout
         published: set[str] = set()
         next_query = 0.0
-        while True:
-            now = time.monotonic()
-            if now >= next_query:
-                published, next_query = self._published(), now + 0.5
-                if not self.use_sim_time:
-                    self._switch_to_sim_time()
-            missing = self._missing(published)
-            pending = [] if missing else self._optional_pending(published)
-            if not missing and not pending:
-                if not self.use_sim_time and self._switch_to_sim_time():
-                    continue  # the simulator came up meanwhile: wait for its clock too
-                break
-            if now >= deadline:
-                if missing:
-                    raise RobotConnectionError(
-                        f"{'; '.join(missing)} after {timeout:g} s "
-                        f"(ROS_MASTER_URI={self.master_uri})"
-                    )
-                rospy.logwarn("pfctl: going on without %s", ", ".join(pending))
-                break
-            time.sleep(0.02)
+        missing = ["the list of topics from the master"]
+        pending: list[str] = []
+        try:
+            while True:
+                now = time.monotonic()
+                if now >= next_query:
+                    published, next_query = self._published(), now + 0.5
+                    if not self.use_sim_time:
+                        self._switch_to_sim_time()
+                missing = self._missing(published)
+                pending = [] if missing else self._optional_pending(published)
+                if not missing and not pending:
+                    if not self.use_sim_time and self._switch_to_sim_time():
+                        continue  # the simulator came up meanwhile: wait for its clock too
+                    break
+                if now >= deadline:
+                    if missing:
+                        raise RobotConnectionError(
+                            f"{'; '.join(missing)} after {timeout:g} s "
+                            f"(ROS_MASTER_URI={self.master_uri})"
+                        )
+                    rospy.logwarn("pfctl: going on without %s", ", ".join(pending))
+                    break
+                time.sleep(0.02)
+        except Interrupted as err:  # Ctrl-C or SIGTERM while waiting: say what for
+            err.during = (
+                f"while waiting for the HSR: {'; '.join(missing or pending)} "
+                f"(ROS_MASTER_URI={self.master_uri})"
+            )
+            raise
         if not self._nav_ready:
             rospy.logwarn(
                 "pfctl: no move_base action server on %s: navigation goals will abort",

@@ -3,10 +3,9 @@
 :func:`run_simulation` steps a :class:`SimRobot` for ``duration`` simulated seconds. Each control
 period it asks the driver (a script, the keyboard, or none: the robot stands still) for a
 command, steps the simulator, hands the observation and the ground truth to the recorder, and
-keeps the truth for the picture. Inside :func:`pfctl.interrupts.graceful_interrupts`, Ctrl-C ends
-the run between two periods: the result says ``interrupted`` and what was recorded so far is a
-complete episode (a second Ctrl-C interrupts at once). The base is stopped at the end whatever
-happens.
+keeps the truth for the picture. Inside :func:`pfctl.interrupts.graceful_interrupts`, Ctrl-C or
+SIGTERM ends the run between two periods: the result says ``interrupted`` and what was recorded
+so far is a complete episode. The base is stopped at the end whatever happens.
 """
 
 from __future__ import annotations

@@ -27,9 +27,9 @@ process instead:
   GIL), widened on Linux so that a few crops never make :meth:`submit` wait for the child;
 - :meth:`close` (or leaving the ``with`` block) stops the child and reaps it; a worker that is
   garbage-collected or still open at interpreter exit is stopped too. The child ignores Ctrl-C
-  (the parent decides when to stop) and exits by itself when its parent has died (the job pipe
-  reaches its end; it finishes the job at hand first). A child that dies is reported as one
-  line (:class:`FaceWorkerError`) by the next call.
+  and SIGTERM (the parent decides when to stop) and exits by itself when its parent has died
+  (the job pipe reaches its end; it finishes the job at hand first). A child that dies is
+  reported as one line (:class:`FaceWorkerError`) by the next call.
 
 One worker serves one :class:`~pfctl.core.perception.identity.identifier.TargetIdentifier` at a time
 (its job keys are unique; an identifier ignores the results of jobs that are not its own).
@@ -43,9 +43,10 @@ import multiprocessing
 import os
 import signal
 import sys
+import threading
 import time
 import weakref
-from collections.abc import Hashable, Iterable
+from collections.abc import Hashable, Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from multiprocessing.connection import Connection, wait
 from typing import Any
@@ -159,6 +160,30 @@ def wait_while_running(pid: int, limit_s: float, poll_s: float = 0.001) -> None:
         time.sleep(poll_s)
 
 
+_PARENTS_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+"""Signals the child ignores: the parent handles them and then stops the child."""
+
+
+@contextlib.contextmanager
+def _started_ignoring(signals: tuple[int, ...]) -> Iterator[None]:
+    """A child started inside ignores ``signals`` from its first instruction (an ignored signal
+    stays ignored across exec, and Python then installs no handler): a Ctrl-C to the whole group
+    while it imports must not kill it. This thread blocks them meanwhile, so that Linux keeps one
+    that comes for this process pending for its own handler (blocked signals are never
+    discarded as ignored)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    signal.pthread_sigmask(signal.SIG_BLOCK, signals)
+    previous = {s: signal.signal(s, signal.SIG_IGN) for s in signals}
+    try:
+        yield
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, signals)
+
+
 def _serve(
     params: FaceParams,
     jobs: Connection,
@@ -168,7 +193,10 @@ def _serve(
     cpus: tuple[int, ...] | None,
 ) -> None:
     """The child's main loop: load the models once, then answer jobs until told to stop."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    # Ctrl-C and SIGTERM are the parent's to handle (a terminal, `timeout` and systemd signal
+    # the whole group): it stops the run and then this child; the child ends if the parent dies
+    for signum in _PARENTS_SIGNALS:
+        signal.signal(signum, signal.SIG_IGN)  # already from the start (_started_ignoring)
     _lower_priority(nice, idle, cpus)
     t0 = time.perf_counter()
     try:
@@ -220,10 +248,7 @@ def _shutdown(process: Any, jobs: Connection, results: Connection, timeout: floa
             jobs.send(None)
         process.join(timeout)
     if process.is_alive():
-        process.terminate()
-        process.join(1.0)
-    if process.is_alive():
-        process.kill()
+        process.kill()  # it ignores SIGTERM
         process.join()
     jobs.close()
     results.close()
@@ -278,7 +303,8 @@ class FaceWorker:
             daemon=True,
         )
         try:
-            self._process.start()
+            with _started_ignoring(_PARENTS_SIGNALS):
+                self._process.start()
         except AssertionError as err:  # "daemonic processes are not allowed to have children"
             for conn in (self._jobs, self._results, child_end, job_end):
                 conn.close()

@@ -343,3 +343,120 @@ def test_killing_the_bridge_stops_the_base_and_ends_the_follower(
     assert "Traceback" not in text
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["lost"] and metrics["first_identified_s"] is not None
+
+
+def _group_signal(process: subprocess.Popen[bytes], signum: int) -> None:
+    os.killpg(process.pid, signum)
+
+
+def test_sigterm_stops_the_base_and_writes_what_was_measured(
+    learned: tuple[subprocess.CompletedProcess[str], Path], master: RosMaster, tmp_path: Path
+) -> None:
+    """SIGTERM (timeout, systemd: to the whole group) of ``follow --backend hsr`` while the robot
+    follows Alice: a zero Twist within 0.5 s and as the last command, the outputs written, one
+    line and exit 143."""
+    _, profile = learned
+    listener_log = tmp_path / "listener.log"
+    listener = _spawn(
+        [sys.executable, str(Path(__file__).parent / "nodes" / "twist_listener.py")],
+        master.env,
+        listener_log,
+    )
+    bridge_log = tmp_path / "serve.log"
+    bridge = _spawn(
+        [*PFCTL, "sim", "serve-hsr", str(HOUSE), "--seed", "1", "--wait-for-command"],
+        master.env,
+        bridge_log,
+    )
+    out = tmp_path / "follow"
+    follow: subprocess.Popen[bytes] | None = None
+    try:
+        _serving(bridge, bridge_log)
+        follow = _spawn(
+            [*PFCTL, "follow", str(HOUSE), "--backend", "hsr", "--target", str(profile),
+             "--duration", "60", "--out", str(out)],
+            master.env,
+            tmp_path / "follow.log",
+        )  # fmt: skip
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:  # the robot follows: it drives
+            moving = [c for c in _commands(listener_log) if abs(c[1]) + abs(c[2]) > 0.05]
+            if len(moving) >= 5:
+                break
+            assert follow.poll() is None, (tmp_path / "follow.log").read_text()
+            time.sleep(0.1)
+        else:
+            raise AssertionError("the follower never drove: " + listener_log.read_text()[-500:])
+        signalled = time.monotonic()
+        _group_signal(follow, signal.SIGTERM)
+        code = follow.wait(timeout=60)
+        time.sleep(0.5)  # the listener's last lines
+    finally:
+        for process in (follow, bridge, listener):
+            if process is not None:
+                _stop(process)
+    after = [c for c in _commands(listener_log) if c[0] >= signalled]
+    zero = next((c for c in after if c[1:] == (0.0, 0.0, 0.0)), None)
+    assert zero is not None, f"no zero Twist after SIGTERM: {after[:5]}"
+    assert zero[0] - signalled <= 0.5, f"zero Twist {zero[0] - signalled:.3f} s after SIGTERM"
+    assert after[-1][1:] == (0.0, 0.0, 0.0), f"the last command was not zero: {after[-1]}"
+    text = (tmp_path / "follow.log").read_text(errors="replace")
+    assert code == 143, text
+    assert "Traceback" not in text
+    lines = [line for line in text.splitlines() if line.startswith("pfctl:")]
+    assert len(lines) == 1 and lines[0].startswith("pfctl: interrupted (SIGTERM) after"), text
+    assert lines[0].endswith(f"wrote {out}")
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["interrupted"] is True and metrics["first_identified_s"] is not None
+
+
+def _subscribes(master: RosMaster, topic: str, prefix: str) -> bool:
+    """Some node whose name starts with ``prefix`` subscribes to ``topic`` on ``master``."""
+    code, _, (_, subscribers, _) = master.proxy().getSystemState("/pytest")
+    return code == 1 and any(
+        t == topic and any(n.startswith(prefix) for n in nodes) for t, nodes in subscribers
+    )
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["int", "term"])
+def test_a_signal_while_waiting_for_the_robot_says_what_for(
+    master: RosMaster, tmp_path: Path, signum: int
+) -> None:
+    """Ctrl-C or SIGTERM while ``follow --backend hsr`` waits for a robot that is not there
+    (a master, no HSR topics): one line naming what it waited for, exit 130 or 143."""
+    from pfctl.app.profiles import save_target_profile
+    from pfctl.core.perception.identity.profile import TargetProfile
+
+    rng = np.random.default_rng(1)
+    upper, lower = rng.random(256), rng.random(256)
+    profile = save_target_profile(
+        TargetProfile(upper / upper.sum(), lower / lower.sum(), np.zeros((0, 128)), frames=1),
+        tmp_path / "someone.npz",
+    )
+    log = tmp_path / "follow.log"
+    follow = _spawn(
+        [*PFCTL, "follow", str(HOUSE), "--backend", "hsr", "--target", str(profile),
+         "--out", str(tmp_path / "follow")],
+        master.env,
+        log,
+    )  # fmt: skip
+    try:
+        deadline = time.monotonic() + 60
+        # the move_base client is the last thing pfctl sets up before it waits for the robot
+        while not _subscribes(master, "/move_base/move/feedback", "/pfctl"):
+            assert follow.poll() is None, log.read_text(errors="replace")
+            assert time.monotonic() < deadline, "pfctl never subscribed to the laser"
+            time.sleep(0.05)
+        _group_signal(follow, signum)
+        code = follow.wait(timeout=30)
+    finally:
+        _stop(follow)
+    text = log.read_text(errors="replace")
+    assert code == 128 + signum, text
+    assert "Traceback" not in text
+    name = signal.Signals(signum).name
+    lines = [line for line in text.splitlines() if line.startswith("pfctl:")]
+    assert len(lines) == 1, text
+    assert lines[0].startswith(f"pfctl: interrupted ({name}) while waiting for the HSR: "), text
+    assert "no laser scan on /hsrb/base_scan" in lines[0]
+    assert not (tmp_path / "follow").exists()

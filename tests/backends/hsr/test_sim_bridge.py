@@ -487,14 +487,17 @@ def test_serves_the_hsr_interfaces(ros_master, ros_nodes, tmp_path):
 def test_commands_drive_the_served_robot(ros_master, ros_nodes, tmp_path):
     """Twist, head trajectory, move_base (succeeded, cancelled, preempted by a Twist and by a
     new goal, aborted, rejected) and the viewpoint stop service; --hide puts the target in the
-    bedroom; Ctrl-C ends the bridge with exit 0."""
+    bedroom; Ctrl-C ends the bridge with exit 130 and one line."""
     bridge = start_bridge(ros_master, tmp_path, "--rate", "2", "--hide", "bedroom")
     wait_serving(bridge, tmp_path)
     got = probe_result(ros_nodes(COMMANDER, str(HOUSE)))
     os.killpg(bridge.pid, signal.SIGINT)
     code, out, err = finish_bridge(bridge, tmp_path)
-    assert code == 0, err
+    assert code == 130, err
     assert "Traceback" not in err
+    assert [line for line in err.splitlines() if line.startswith("pfctl:")] == [
+        f"pfctl: interrupted (SIGINT) after serving {out.split()[2]} s simulated"
+    ]
     assert out.startswith("interrupted after")
     assert "1 viewpoint stops" in out and "0 collisions" in out
 
@@ -523,7 +526,7 @@ def test_commands_drive_the_served_robot(ros_master, ros_nodes, tmp_path):
 def test_wait_for_command_holds_the_episode(ros_master, ros_nodes, tmp_path):
     """--wait-for-command: the clock runs and the truth is published again with new stamps
     while nobody moves; the first (head) command starts the episode; SIGTERM ends the bridge
-    with exit 0. --pose-target: the target stands 1.4 m in front of the robot."""
+    with exit 143 and one line. --pose-target: the target stands 1.4 m in front of the robot."""
     bridge = start_bridge(
         ros_master, tmp_path, "--rate", "2", "--wait-for-command", "--pose-target"
     )
@@ -532,8 +535,9 @@ def test_wait_for_command_holds_the_episode(ros_master, ros_nodes, tmp_path):
     got = probe_result(ros_nodes(HOLDER, str(HOUSE)))
     os.killpg(bridge.pid, signal.SIGTERM)
     code, out, err = finish_bridge(bridge, tmp_path)
-    assert code == 0, err
+    assert code == 143, err
     assert "Traceback" not in err
+    assert sum(line.startswith("pfctl: interrupted (SIGTERM)") for line in err.splitlines()) == 1
     assert "the first command came after" in err
     assert out.startswith("interrupted after") and "simulated (after holding for" in out
 

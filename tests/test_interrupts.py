@@ -1,0 +1,75 @@
+"""SIGINT and SIGTERM alike (:mod:`pfctl.interrupts`), with real signals to this process: at once
+before a run, at the next tick in one, the second only acknowledged, the third abandoning."""
+
+from __future__ import annotations
+
+import signal
+
+import pytest
+
+from pfctl.interrupts import Interrupted, command_signals, graceful_interrupts
+
+
+def _kill(signum: int) -> None:
+    """Send ``signum`` to this thread: its Python handler runs before this returns."""
+    signal.raise_signal(signum)
+
+
+@pytest.mark.parametrize(("signum", "status"), [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_before_a_run_a_signal_ends_the_command_at_once(signum: int, status: int) -> None:
+    with command_signals(), pytest.raises(Interrupted) as raised:
+        _kill(signum)
+    assert raised.value.exit_status == status
+    assert raised.value.line() == f"pfctl: interrupted ({signal.Signals(signum).name})\n"
+
+
+def test_in_a_run_the_first_stops_the_second_is_acknowledged_the_third_abandons(
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    with command_signals():
+        with graceful_interrupts() as stop:
+            assert not stop()
+            _kill(signal.SIGTERM)
+            assert stop() and stop.signum == signal.SIGTERM
+        _kill(signal.SIGINT)  # after the run, while writing: still no exception
+        err = capfd.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("SIGINT: still stopping")
+        with pytest.raises(Interrupted) as raised:
+            _kill(signal.SIGINT)
+    assert raised.value.signum == signal.SIGTERM and raised.value.exit_status == 143
+    assert "abandoned" in raised.value.line()
+
+
+def test_a_signal_while_writing_after_a_whole_run_is_not_lost(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    with command_signals():
+        with graceful_interrupts() as stop:
+            pass
+        _kill(signal.SIGINT)
+        assert stop() and stop.signum == signal.SIGINT
+        with pytest.raises(SystemExit) as ended:
+            stop.exit_if_set("after 3.0 s; wrote out")
+    assert ended.value.code == 130
+    assert capsys.readouterr().err == "pfctl: interrupted (SIGINT) after 3.0 s; wrote out\n"
+
+
+def test_outside_a_command_a_run_handles_both_signals_and_restores_the_handlers() -> None:
+    before = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    with graceful_interrupts() as stop:
+        _kill(signal.SIGTERM)
+        assert stop.signum == signal.SIGTERM
+    assert {s: signal.getsignal(s) for s in before} == before
+
+
+def test_a_signal_ignored_at_start_stays_ignored() -> None:
+    """A background job of a shell without job control ignores Ctrl-C: so does the command."""
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        with command_signals():
+            assert signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+            with graceful_interrupts() as stop:
+                _kill(signal.SIGINT)
+            assert not stop()
+    finally:
+        signal.signal(signal.SIGINT, previous)
