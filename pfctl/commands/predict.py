@@ -209,7 +209,7 @@ def _track_csv(
 ) -> str:
     lines = ["t,x,y" + (",region,clipped" if clipped is not None else "")]
     for i, (t, (x, y)) in enumerate(zip(times, xy, strict=True)):
-        row = f"{t:.6g},{x:.4f},{y:.4f}"
+        row = f"{float(t)!r},{float(x)!r},{float(y)!r}"
         if clipped is not None and regions is not None:
             region = regions.locate((x, y)) or ""
             stopped = clipped.stop_index is not None and i >= clipped.stop_index
