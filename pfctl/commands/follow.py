@@ -51,6 +51,7 @@ from pfctl.app.episodes import (
 )
 from pfctl.app.follower import EpisodeResult
 from pfctl.app.tracks_file import tracks_csv
+from pfctl.commands import check_seed
 from pfctl.core.metrics import (
     FollowMetrics,
     SearchMetrics,
@@ -146,7 +147,10 @@ def follow(
         ),
     ] = None,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Simulator seed (default: scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[
         float, typer.Option("--duration", help="Seconds (simulated, or ROS time on hsr).")
@@ -339,7 +343,10 @@ def search(
         typer.Option("--region", help="Sim: where the target hides (default: chosen by the seed)."),
     ] = None,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Simulator seed (default: scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[float, typer.Option("--duration", help="Give up after (s).")] = 180.0,
     out: Annotated[

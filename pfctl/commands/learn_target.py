@@ -34,6 +34,7 @@ from pfctl.app.learn_target import (
     learn_on_hsr,
 )
 from pfctl.app.perception import identity_params
+from pfctl.commands import check_seed
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.robot import RobotLostError
@@ -71,6 +72,7 @@ def learn_target(
         int | None,
         typer.Option(
             "--seed",
+            callback=check_seed,
             help="Sim seed (default: scenario.seed); people's faces depend on it, so use the "
             "seed you will follow with.",
         ),

@@ -36,6 +36,7 @@ from pfctl.app.leg_data import (
 )
 from pfctl.app.leg_models import load_leg_model, save_leg_model
 from pfctl.app.perception import leg_params
+from pfctl.commands import check_seed
 from pfctl.core.perception.legs.detector import LegParams
 from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.perception.legs.training import (
@@ -112,7 +113,9 @@ def train_command(
         list[Path] | None,
         typer.Option("--real", help="A folder of real leg bags (repeatable)."),
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the scans and the forest.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the scans and the forest.")
+    ] = 0,
     out: Annotated[Path, typer.Option("--out", help="The model file to write.")] = Path(
         "legs_model.npz"
     ),
@@ -232,7 +235,9 @@ def evaluate_command(
         int,
         typer.Option("--sim-scans", help="Simulated scans to test on (and to train each fold on)."),
     ] = 1000,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the training scans.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the training scans.")
+    ] = 0,
     mission: Annotated[
         Path | None,
         typer.Option("--mission", help="Mission: the house and perception.legs (default: house)."),

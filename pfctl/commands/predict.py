@@ -31,6 +31,7 @@ from typer.core import TyperGroup
 
 from pfctl.app.follower import prediction_params
 from pfctl.app.trajectory_files import read_csv_trajectory, read_trajectories
+from pfctl.commands import check_seed
 from pfctl.core.follower import PredictionParams
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
@@ -543,7 +544,9 @@ def search_command(
     test_fraction: Annotated[
         float, typer.Option("--test-fraction", help="Share of the people held out for the test.")
     ] = 0.5,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the split.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the split.")
+    ] = 0,
     metric: Annotated[
         Metric, typer.Option("--metric", help="What to minimise: ade, fde or both (their mean).")
     ] = Metric.ade,
@@ -670,7 +673,9 @@ def door(
     plot: Annotated[
         Path | None, typer.Option("--plot", help="PNG: three panels, truth vs SVR vs poly3.")
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the walks.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the walks.")
+    ] = 0,
     walks: Annotated[int, typer.Option("--walks", help="Walks per case.", min=1)] = 20,
     history_s: Annotated[
         float, typer.Option("--history", help="Seconds of walk the models see.")

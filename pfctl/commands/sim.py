@@ -30,6 +30,7 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+from pfctl.commands import check_seed
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
 from pfctl.files import check_episode_dir
@@ -50,7 +51,10 @@ def run(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
     duration: Annotated[float, typer.Option("--duration", help="Simulated seconds to run.")] = 60.0,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Seed (default: the mission's scenario.seed)."
+        ),
     ] = None,
     record: Annotated[
         Path | None,
@@ -271,7 +275,10 @@ def export_map(
 def serve_hsr(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Seed (default: the mission's scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[
         float | None,

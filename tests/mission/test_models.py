@@ -348,6 +348,14 @@ BROKEN = [
         id="target-not-among-people",
     ),
     pytest.param(
+        "target: alice",
+        "seed: -1\n  target: alice",
+        17,
+        "scenario.seed",
+        [">= 0", "got -1"],
+        id="seed-negative",
+    ),
+    pytest.param(
         "[kitchen, hall, [1.0, 4.5]]",
         "[kitchen, garage, [1.0, 4.5]]",
         21,
