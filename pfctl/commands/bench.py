@@ -45,7 +45,7 @@ from pfctl.bench.runner import (
 from pfctl.bench.variants import parse_vary, variants
 from pfctl.commands import check_seed
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_dir, write_output
 from pfctl.mission.types import SEED_MAX
 from pfctl.progress import progress_bar
 
@@ -204,6 +204,7 @@ def bench(
         raise UserError("--ray: expected auto, ray://HOST:PORT or local")
     if ray is not None and not ray_available():
         raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
+    check_output_dir(out, "--out")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
     campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
     records, writer = open_results(out, campaign, resume)

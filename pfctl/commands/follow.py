@@ -61,7 +61,7 @@ from pfctl.core.metrics import (
 from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all, check_episode_dir
+from pfctl.files import atomic_write_all, check_episode_dir, check_output_dir
 from pfctl.interrupts import graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
@@ -84,8 +84,10 @@ def _check_common(
         raise UserError(f"--backend {backend}: expected one of {', '.join(BACKENDS)}")
     if not (math.isfinite(duration) and duration > 0):
         raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a directory")
+    check_output_dir(out, "--out")
+    if record is not None:
+        check_episode_dir(record)
+        check_output_dir(record, "--record")
     if backend == "hsr":
         if target is None:
             raise UserError(

@@ -39,7 +39,7 @@ from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.robot import RobotLostError
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all
+from pfctl.files import atomic_write_all, check_output_file
 from pfctl.mission import load_mission
 
 BACKENDS = ("sim", "hsr")
@@ -89,10 +89,10 @@ def learn_target(
         raise UserError(f"--seconds: expected a positive duration, got {seconds}")
     if out.suffix.lower() != ".npz":
         raise UserError(f"--out {out}: expected a path ending in .npz")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
     if plot is not None and plot.suffix.lower() != ".png":
         raise UserError(f"--plot {plot}: expected a path ending in .png")
+    check_output_file(out, "--out", make_folder=False)
+    check_output_file(plot, "--plot", make_folder=False)
     loaded = load_mission(mission)
     params = identity_params(loaded)
     console = Console(stderr=True)

@@ -49,6 +49,7 @@ from pfctl.core.perception.legs.training import (
     train_forest,
 )
 from pfctl.errors import UserError
+from pfctl.files import check_output_file
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 
@@ -126,10 +127,7 @@ def train_command(
 ) -> None:
     """Train the leg classifier on simulated (and real) scans; write it as an .npz."""
     _check_count(sim_scans, "--sim-scans")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
-    if not out.parent.is_dir():
-        raise UserError(f"--out {out}: no such folder {out.parent}")
+    check_output_file(out, "--out", make_folder=False)
     m = _mission(mission)
     params = leg_params(m)
     parts = []
@@ -256,6 +254,7 @@ def evaluate_command(
 ) -> None:
     """Precision, recall and F1 of leg segments per data set (0.5–5 m and all ranges)."""
     _check_count(sim_scans, "--sim-scans", 1)
+    check_output_file(json_out, "--json", make_folder=False)
     m = _mission(mission)
     params = leg_params(m)
     if history is not None:

@@ -50,7 +50,7 @@ from pfctl.core.prediction.models import (
 from pfctl.core.prediction.search import grid_search
 from pfctl.core.prediction.trajectories import Trajectory
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_file, write_output
 from pfctl.mission import Mission, load_mission
 from pfctl.mission.map_server import GridFileError, load_map_server
 from pfctl.progress import progress_bar
@@ -148,8 +148,7 @@ def _mission_params(mission: Mission | None, name: str) -> dict[str, Any]:
 def _prepare_output(path: Path | None, option: str) -> None:
     if path is None:
         return
-    if path.is_dir():
-        raise UserError(f"{option} {path}: is a directory, expected a file path")
+    check_output_file(path, option)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as err:

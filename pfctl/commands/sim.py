@@ -33,7 +33,7 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 from pfctl.commands import check_seed
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
-from pfctl.files import check_episode_dir
+from pfctl.files import check_episode_dir, check_output_dir, check_output_file
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 from pfctl.mission.map_server import GridFileError, save_map_server
@@ -112,8 +112,9 @@ def run(
         png = record / "paths.png" if record is not None else Path("sim_run.png")
     if png.suffix.lower() != ".png":
         raise UserError(f"--png {png}: expected a path ending in .png")
-    if png.is_dir():
-        raise UserError(f"--png {png}: is a directory, expected a file path")
+    if record is not None:
+        check_output_dir(record, "--record")
+    check_output_file(png, "--png")
     loaded = load_mission(mission)
     steps = None
     if script is not None:
@@ -249,8 +250,7 @@ def export_map(
         raise UserError(f"--resolution: expected a positive cell size in metres, got {resolution}")
     if out.suffix.lower() not in (".yaml", ".yml"):
         raise UserError(f"--out {out}: expected a map_server YAML path ending in .yaml")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
+    check_output_file(out, "--out")
     loaded = load_mission(mission)
     grid = rasterize_house(
         loaded.layout(),

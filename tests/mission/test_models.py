@@ -606,7 +606,7 @@ def test_schema_out_writes_the_file_atomically(
     nowhere = tmp_path / "no" / "dir" / "schema.json"
     code, _, err = run_cli(["mission", "schema", "--out", str(nowhere)], capsys, monkeypatch)
     assert code == 2
-    assert_one_error_line(err, f"pfctl: error: {nowhere}: cannot write")
+    assert_one_error_line(err, f"pfctl: error: --out {nowhere}: no such folder {nowhere.parent}")
     assert not nowhere.parent.exists()
 
 
