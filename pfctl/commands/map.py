@@ -36,7 +36,13 @@ from pfctl.errors import MissionError, UserError
 from pfctl.files import check_output_file, write_output
 from pfctl.mission import Mission, load_mission, loads_mission
 from pfctl.mission.edit import render_regions
-from pfctl.mission.map_server import GridFileError, load_map_server, save_map_server
+from pfctl.mission.map import grid_memory_issue, house_grid_issue
+from pfctl.mission.map_server import (
+    GridFileError,
+    load_map_server,
+    map_server_size,
+    save_map_server,
+)
 
 app = typer.Typer(help="Maps: annotate regions and doors, render them.", no_args_is_help=True)
 
@@ -83,9 +89,19 @@ def _read_yaml_mapping(path: Path, what: str) -> dict[str, Any]:
 
 def _load_map_server(path: Path) -> OccupancyGrid:
     try:
+        issue = grid_memory_issue(*map_server_size(path))
+        if issue:
+            raise UserError(f"{path}: {issue}")
         return load_map_server(path)
     except GridFileError as err:
         raise UserError(str(err)) from None
+
+
+def _check_resolution(layout: HouseLayout, resolution: float | None) -> None:
+    """An explicit ``--resolution`` must keep the house's grids within the memory limit."""
+    issue = house_grid_issue(layout, resolution) if resolution is not None else None
+    if issue:
+        raise UserError(f"--resolution {resolution:g}: {issue}")
 
 
 def load_source(path: Path, resolution: float | None = None) -> Source:
@@ -109,6 +125,7 @@ def load_source(path: Path, resolution: float | None = None) -> Source:
         if mission.map.occupancy is not None and resolution is None:
             occupancy = Path(mission.map.occupancy)
             return Source(path, _load_map_server(occupancy), mission, occupancy)
+        _check_resolution(mission.layout(), resolution)
         grid = rasterize_house(
             mission.layout(),
             resolution if resolution is not None else mission.map.resolution,
@@ -492,6 +509,7 @@ def export(
         raise UserError(f"--out {out}: expected a map_server YAML path ending in .yaml")
     check_output_file(out, "--out")
     loaded = load_mission(mission)
+    _check_resolution(loaded.layout(), resolution)
     grid = rasterize_house(
         loaded.layout(),
         resolution if resolution is not None else loaded.map.resolution,

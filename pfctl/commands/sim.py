@@ -36,6 +36,7 @@ from pfctl.errors import UserError
 from pfctl.files import check_episode_dir, check_output_dir, check_output_file
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
+from pfctl.mission.map import house_grid_issue
 from pfctl.mission.map_server import GridFileError, save_map_server
 
 if TYPE_CHECKING:  # the simulator is imported when a command needs it: pybullet loads slowly
@@ -252,6 +253,9 @@ def export_map(
         raise UserError(f"--out {out}: expected a map_server YAML path ending in .yaml")
     check_output_file(out, "--out")
     loaded = load_mission(mission)
+    issue = house_grid_issue(loaded.layout(), resolution) if resolution is not None else None
+    if issue:
+        raise UserError(f"--resolution {resolution:g}: {issue}")
     grid = rasterize_house(
         loaded.layout(),
         resolution if resolution is not None else loaded.map.resolution,
