@@ -19,6 +19,8 @@ COMMANDS = [
     pytest.param(["bench", HOUSE, "--episodes", "1"], "bench", id="bench"),
     pytest.param(["learn-target", HOUSE, "--backend", "sim"], "learn-target", id="learn-target"),
     pytest.param(["legs", "train", "--sim-scans", "10"], "legs train", id="legs-train"),
+    pytest.param(["legs", "evaluate", "--sim-scans", "10"], "legs evaluate", id="legs-evaluate"),
+    pytest.param(["sim", "serve-hsr", HOUSE], "sim serve-hsr", id="serve-hsr"),
     pytest.param(["predict", "search", "data"], "predict search", id="predict-search"),
     pytest.param(["predict", "experiment", "door"], "predict experiment door", id="door"),
 ]
