@@ -7,6 +7,11 @@ import sys
 
 import typer
 
+try:  # typer 0.2x carries its own copy of click
+    from typer._click.exceptions import ClickException, NoArgsIsHelpError
+except ImportError:  # pragma: no cover - older typer uses click itself
+    from click.exceptions import ClickException, NoArgsIsHelpError
+
 from pfctl import __version__
 from pfctl.commands import bench as bench_command
 from pfctl.commands import bt as bt_commands
@@ -58,12 +63,44 @@ def _root(
     """Person-following with active target search."""
 
 
+def _run_app() -> None:
+    """Run the app; a usage error (unknown option, value out of range, missing argument) is one
+    line ``pfctl: error: COMMAND: what is wrong; see --help`` and exit status 2, not the framework's
+    box. Running without arguments still prints the help."""
+    try:
+        status = app(standalone_mode=False)
+    except NoArgsIsHelpError as err:  # typer has printed the help already (rich)
+        if err.format_message().strip():
+            err.show()
+        sys.exit(err.exit_code)
+    except ClickException as err:
+        sys.stderr.write(f"pfctl: error: {_usage_line(err)}\n")
+        sys.exit(err.exit_code)
+    except typer.Abort:
+        sys.stderr.write("pfctl: aborted\n")
+        sys.exit(1)
+    sys.exit(status if isinstance(status, int) else 0)
+
+
+def _usage_line(err: ClickException) -> str:
+    message = " ".join(err.format_message().split()).rstrip(".")
+    ctx = getattr(err, "ctx", None)
+    names: list[str] = []
+    while ctx is not None and ctx.parent is not None:
+        names.append(ctx.info_name or "")
+        ctx = ctx.parent
+    if not names:
+        return f"{message}; see pfctl --help"
+    command = " ".join(reversed(names))
+    return f"{command}: {message}; see pfctl {command} --help"
+
+
 def main() -> None:
     """Console entry point: user errors become one line on stderr and exit status 2; SIGINT and
     SIGTERM (:mod:`pfctl.interrupts`) one line and exit status 130 or 143."""
     with command_signals():
         try:
-            app()
+            _run_app()
         except UserError as err:
             sys.stderr.write(f"pfctl: error: {err}\n")
             sys.exit(err.exit_code)

@@ -107,6 +107,8 @@ class Bag:
         self.path = Path(path)
         if not self.path.exists():
             raise BagError(f"{self.path}: no such bag file")
+        if self.path.is_dir() and not (self.path / "metadata.yaml").is_file():
+            raise BagError(_not_a_bag_folder(self.path))
         ros1 = self.path.is_file() and self.path.suffix == ".bag"
         store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
         try:
@@ -172,6 +174,18 @@ class Bag:
         self.require(topic, POSE_ARRAY)
         for m in self.messages([topic]):
             yield pose_array(m.msg)
+
+
+def _not_a_bag_folder(path: Path) -> str:
+    """What a folder without a ROS 2 bag's ``metadata.yaml`` was expected to be."""
+    message = (
+        f"{path}: a folder but not a ROS 2 bag (no metadata.yaml); expected a ROS 1 .bag file, "
+        "a ROS 2 bag folder or its .mcap/.db3 file"
+    )
+    episode_bag = path / "episode.bag"
+    if episode_bag.is_file():
+        message += f" (this looks like a pfctl recording: give {episode_bag})"
+    return message
 
 
 def open_bag(path: Path) -> Bag:

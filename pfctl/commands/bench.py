@@ -43,8 +43,10 @@ from pfctl.bench.runner import (
     run_on_ray,
 )
 from pfctl.bench.variants import parse_vary, variants
+from pfctl.commands import check_seed
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_dir, write_output
+from pfctl.mission.types import SEED_MAX
 from pfctl.progress import progress_bar
 
 #: Default simulated seconds of an episode per task.
@@ -148,7 +150,8 @@ def bench(
         int, typer.Option("--episodes", help="Episodes per mission and variant.")
     ] = 10,
     seed: Annotated[
-        int, typer.Option("--seed", help="Seed of episode 0; episode i: seed + i.")
+        int,
+        typer.Option("--seed", callback=check_seed, help="Seed of episode 0; episode i: seed + i."),
     ] = 1,
     duration: Annotated[
         float | None,
@@ -192,10 +195,16 @@ def bench(
     seconds = DEFAULT_DURATION.get(task, 120.0) if duration is None else duration
     jobs = (os.cpu_count() or 1) if workers is None else workers
     _check_options(task, episodes, jobs, seconds, timeout)
+    if seed + episodes - 1 > SEED_MAX:
+        raise UserError(
+            f"--seed {seed} --episodes {episodes}: the last episode's seed "
+            f"{seed + episodes - 1} is above {SEED_MAX} (2**32 - 1)"
+        )
     if ray is not None and ray != "local" and not ray.strip():
         raise UserError("--ray: expected auto, ray://HOST:PORT or local")
     if ray is not None and not ray_available():
         raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
+    check_output_dir(out, "--out")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
     campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
     records, writer = open_results(out, campaign, resume)

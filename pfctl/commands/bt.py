@@ -21,7 +21,7 @@ import typer
 
 from pfctl.core.behavior.registry import LEAF_SPECS, ParamSpec
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_file, write_output
 from pfctl.mission import load_mission
 from pfctl.plots.behavior_tree import ascii_tree, btcpp_xml, dot_tree, png_tree
 
@@ -59,6 +59,7 @@ def show(
     """Draw the behavior tree of MISSION (§II-A, Fig. 2 of the paper)."""
     if fmt not in FORMATS:
         raise UserError(f"--format {fmt}: expected one of {', '.join(FORMATS)}")
+    check_output_file(out, "--out", make_folder=False)
     loaded = load_mission(mission)
     layout = loaded.behavior.tree.model_dump(exclude_none=True)
     try:

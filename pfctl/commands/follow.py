@@ -52,6 +52,7 @@ from pfctl.app.episodes import (
 )
 from pfctl.app.follower import EpisodeResult
 from pfctl.app.tracks_file import tracks_csv
+from pfctl.commands import check_seed
 from pfctl.core.metrics import (
     FollowMetrics,
     SearchMetrics,
@@ -61,7 +62,7 @@ from pfctl.core.metrics import (
 from pfctl.core.perception.face_worker import FaceWorkerError
 from pfctl.core.perception.identity.profile import TargetProfile
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all, check_episode_dir
+from pfctl.files import atomic_write_all, check_episode_dir, check_output_dir
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
 
@@ -84,8 +85,10 @@ def _check_common(
         raise UserError(f"--backend {backend}: expected one of {', '.join(BACKENDS)}")
     if not (math.isfinite(duration) and duration > 0):
         raise UserError(f"--duration: expected a positive number of seconds, got {duration:g}")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a directory")
+    check_output_dir(out, "--out")
+    if record is not None:
+        check_episode_dir(record)
+        check_output_dir(record, "--record")
     if backend == "hsr":
         if target is None:
             raise UserError(
@@ -147,7 +150,10 @@ def follow(
         ),
     ] = None,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Simulator seed (default: scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[
         float, typer.Option("--duration", help="Seconds (simulated, or ROS time on hsr).")
@@ -342,7 +348,10 @@ def search(
         typer.Option("--region", help="Sim: where the target hides (default: chosen by the seed)."),
     ] = None,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Simulator seed (default: scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Simulator seed (default: scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[float, typer.Option("--duration", help="Give up after (s).")] = 180.0,
     out: Annotated[

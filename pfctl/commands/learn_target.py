@@ -34,11 +34,12 @@ from pfctl.app.learn_target import (
     learn_on_hsr,
 )
 from pfctl.app.perception import identity_params
+from pfctl.commands import check_seed
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.core.robot import RobotLostError
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all
+from pfctl.files import atomic_write_all, check_output_file
 from pfctl.mission import load_mission
 
 BACKENDS = ("sim", "hsr")
@@ -71,6 +72,7 @@ def learn_target(
         int | None,
         typer.Option(
             "--seed",
+            callback=check_seed,
             help="Sim seed (default: scenario.seed); people's faces depend on it, so use the "
             "seed you will follow with.",
         ),
@@ -87,10 +89,10 @@ def learn_target(
         raise UserError(f"--seconds: expected a positive duration, got {seconds}")
     if out.suffix.lower() != ".npz":
         raise UserError(f"--out {out}: expected a path ending in .npz")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
     if plot is not None and plot.suffix.lower() != ".png":
         raise UserError(f"--plot {plot}: expected a path ending in .png")
+    check_output_file(out, "--out", make_folder=False)
+    check_output_file(plot, "--plot", make_folder=False)
     loaded = load_mission(mission)
     params = identity_params(loaded)
     console = Console(stderr=True)

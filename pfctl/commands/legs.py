@@ -36,6 +36,7 @@ from pfctl.app.leg_data import (
 )
 from pfctl.app.leg_models import load_leg_model, save_leg_model
 from pfctl.app.perception import leg_params
+from pfctl.commands import check_seed
 from pfctl.core.perception.legs.detector import LegParams
 from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.perception.legs.training import (
@@ -48,6 +49,7 @@ from pfctl.core.perception.legs.training import (
     train_forest,
 )
 from pfctl.errors import UserError
+from pfctl.files import check_output_file
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 
@@ -112,7 +114,9 @@ def train_command(
         list[Path] | None,
         typer.Option("--real", help="A folder of real leg bags (repeatable)."),
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the scans and the forest.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the scans and the forest.")
+    ] = 0,
     out: Annotated[Path, typer.Option("--out", help="The model file to write.")] = Path(
         "legs_model.npz"
     ),
@@ -123,10 +127,7 @@ def train_command(
 ) -> None:
     """Train the leg classifier on simulated (and real) scans; write it as an .npz."""
     _check_count(sim_scans, "--sim-scans")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
-    if not out.parent.is_dir():
-        raise UserError(f"--out {out}: no such folder {out.parent}")
+    check_output_file(out, "--out", make_folder=False)
     m = _mission(mission)
     params = leg_params(m)
     parts = []
@@ -232,7 +233,9 @@ def evaluate_command(
         int,
         typer.Option("--sim-scans", help="Simulated scans to test on (and to train each fold on)."),
     ] = 1000,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the training scans.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the training scans.")
+    ] = 0,
     mission: Annotated[
         Path | None,
         typer.Option("--mission", help="Mission: the house and perception.legs (default: house)."),
@@ -251,6 +254,7 @@ def evaluate_command(
 ) -> None:
     """Precision, recall and F1 of leg segments per data set (0.5–5 m and all ranges)."""
     _check_count(sim_scans, "--sim-scans", 1)
+    check_output_file(json_out, "--json", make_folder=False)
     m = _mission(mission)
     params = leg_params(m)
     if history is not None:

@@ -33,10 +33,16 @@ from pfctl.core.mapping.house import Door, HouseLayout, Region
 from pfctl.core.mapping.rooms import RoomParams, name_after, segment_rooms
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import MissionError, UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_file, write_output
 from pfctl.mission import Mission, load_mission, loads_mission
 from pfctl.mission.edit import render_regions
-from pfctl.mission.map_server import GridFileError, load_map_server, save_map_server
+from pfctl.mission.map import grid_memory_issue, house_grid_issue
+from pfctl.mission.map_server import (
+    GridFileError,
+    load_map_server,
+    map_server_size,
+    save_map_server,
+)
 
 app = typer.Typer(help="Maps: annotate regions and doors, render them.", no_args_is_help=True)
 
@@ -83,9 +89,19 @@ def _read_yaml_mapping(path: Path, what: str) -> dict[str, Any]:
 
 def _load_map_server(path: Path) -> OccupancyGrid:
     try:
+        issue = grid_memory_issue(*map_server_size(path))
+        if issue:
+            raise UserError(f"{path}: {issue}")
         return load_map_server(path)
     except GridFileError as err:
         raise UserError(str(err)) from None
+
+
+def _check_resolution(layout: HouseLayout, resolution: float | None) -> None:
+    """An explicit ``--resolution`` must keep the house's grids within the memory limit."""
+    issue = house_grid_issue(layout, resolution) if resolution is not None else None
+    if issue:
+        raise UserError(f"--resolution {resolution:g}: {issue}")
 
 
 def load_source(path: Path, resolution: float | None = None) -> Source:
@@ -109,6 +125,7 @@ def load_source(path: Path, resolution: float | None = None) -> Source:
         if mission.map.occupancy is not None and resolution is None:
             occupancy = Path(mission.map.occupancy)
             return Source(path, _load_map_server(occupancy), mission, occupancy)
+        _check_resolution(mission.layout(), resolution)
         grid = rasterize_house(
             mission.layout(),
             resolution if resolution is not None else mission.map.resolution,
@@ -361,11 +378,10 @@ def annotate(
     flag_regions = [parse_region_spec(s) for s in region or []]
     flag_doors = [parse_door_spec(s) for s in door or []]
     file_layer = load_regions_file(regions_file) if regions_file is not None else ([], [])
+    check_output_file(out, "--out")
+    check_output_file(png, "--png")
     src = load_source(source, resolution)
     grid = src.grid
-    for option, path in (("--out", out), ("--png", png)):
-        if path is not None and path.is_dir():
-            raise UserError(f"{option} {path}: is a directory, expected a file path")
 
     layers: list[tuple[Sequence[Region], Sequence[Door]]] = []
     if auto:
@@ -455,6 +471,7 @@ def render(
     """Draw a mission's map with its regions, doors and region graph to a PNG."""
     if resolution is not None and not (math.isfinite(resolution) and resolution > 0):
         raise UserError(f"--resolution: expected a positive cell size in metres, got {resolution}")
+    check_output_file(png, "--png")
     src = load_source(mission, resolution)
     _prepare_parent(png, "--png")
     layout = src.layout
@@ -490,7 +507,9 @@ def export(
         raise UserError(f"--margin: expected a distance ≥ 0 in metres, got {margin}")
     if out.suffix.lower() not in (".yaml", ".yml"):
         raise UserError(f"--out {out}: expected a map_server YAML path ending in .yaml")
+    check_output_file(out, "--out")
     loaded = load_mission(mission)
+    _check_resolution(loaded.layout(), resolution)
     grid = rasterize_house(
         loaded.layout(),
         resolution if resolution is not None else loaded.map.resolution,

@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 
 from pfctl.errors import MissionError
-from pfctl.files import write_output
+from pfctl.files import check_output_file, write_output
 from pfctl.mission import Mission, dump_json_schema, load_mission
 
 app = typer.Typer(help="Check a mission file, or print its JSON Schema.", no_args_is_help=True)
@@ -58,6 +58,7 @@ def schema(
     ] = None,
 ) -> None:
     """Print the JSON Schema of a mission file, or write it to --out."""
+    check_output_file(out, "--out", make_folder=False)
     text = json.dumps(dump_json_schema(), indent=2) + "\n"
     if out is None:
         typer.echo(text, nl=False)

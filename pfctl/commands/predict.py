@@ -31,6 +31,7 @@ from typer.core import TyperGroup
 
 from pfctl.app.follower import prediction_params
 from pfctl.app.trajectory_files import read_csv_trajectory, read_trajectories
+from pfctl.commands import check_seed
 from pfctl.core.follower import PredictionParams
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
@@ -49,7 +50,7 @@ from pfctl.core.prediction.models import (
 from pfctl.core.prediction.search import grid_search
 from pfctl.core.prediction.trajectories import Trajectory
 from pfctl.errors import UserError
-from pfctl.files import write_output
+from pfctl.files import check_output_file, write_output
 from pfctl.mission import Mission, load_mission
 from pfctl.mission.map_server import GridFileError, load_map_server
 from pfctl.progress import progress_bar
@@ -147,8 +148,7 @@ def _mission_params(mission: Mission | None, name: str) -> dict[str, Any]:
 def _prepare_output(path: Path | None, option: str) -> None:
     if path is None:
         return
-    if path.is_dir():
-        raise UserError(f"{option} {path}: is a directory, expected a file path")
+    check_output_file(path, option)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as err:
@@ -209,7 +209,7 @@ def _track_csv(
 ) -> str:
     lines = ["t,x,y" + (",region,clipped" if clipped is not None else "")]
     for i, (t, (x, y)) in enumerate(zip(times, xy, strict=True)):
-        row = f"{t:.6g},{x:.4f},{y:.4f}"
+        row = f"{float(t)!r},{float(x)!r},{float(y)!r}"
         if clipped is not None and regions is not None:
             region = regions.locate((x, y)) or ""
             stopped = clipped.stop_index is not None and i >= clipped.stop_index
@@ -543,7 +543,9 @@ def search_command(
     test_fraction: Annotated[
         float, typer.Option("--test-fraction", help="Share of the people held out for the test.")
     ] = 0.5,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the split.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the split.")
+    ] = 0,
     metric: Annotated[
         Metric, typer.Option("--metric", help="What to minimise: ade, fde or both (their mean).")
     ] = Metric.ade,
@@ -670,7 +672,9 @@ def door(
     plot: Annotated[
         Path | None, typer.Option("--plot", help="PNG: three panels, truth vs SVR vs poly3.")
     ] = None,
-    seed: Annotated[int, typer.Option("--seed", help="Seed of the walks.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", callback=check_seed, help="Seed of the walks.")
+    ] = 0,
     walks: Annotated[int, typer.Option("--walks", help="Walks per case.", min=1)] = 20,
     history_s: Annotated[
         float, typer.Option("--history", help="Seconds of walk the models see.")

@@ -38,7 +38,7 @@ from pfctl.core.perception.vision import (
 )
 from pfctl.core.robot import LaserScan, RgbdFrame
 from pfctl.errors import UserError
-from pfctl.files import atomic_write_all
+from pfctl.files import atomic_write_all, check_output_dir
 from pfctl.mission import Mission, load_mission
 from pfctl.progress import progress_bar
 
@@ -90,8 +90,7 @@ def replay(
     console = Console(stderr=True)
     mission = _mission(mission_path)
     profile = load_target_profile(target) if target is not None else None
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a folder")
+    check_output_dir(out, "--out")
     source = open_replay(bag, scan_topic=scan_topic, frame=frame, camera=camera)
     with source.bag:
         if profile is not None and source.camera is None:

@@ -28,11 +28,13 @@ import typer
 from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
+from pfctl.commands import check_seed
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
-from pfctl.files import check_episode_dir
+from pfctl.files import check_episode_dir, check_output_dir, check_output_file
 from pfctl.interrupts import StopFlag, graceful_interrupts
 from pfctl.mission import Mission, load_mission
+from pfctl.mission.map import house_grid_issue
 from pfctl.mission.map_server import GridFileError, save_map_server
 
 if TYPE_CHECKING:  # the simulator is imported when a command needs it: pybullet loads slowly
@@ -48,7 +50,10 @@ def run(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
     duration: Annotated[float, typer.Option("--duration", help="Simulated seconds to run.")] = 60.0,
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Seed (default: the mission's scenario.seed)."
+        ),
     ] = None,
     record: Annotated[
         Path | None,
@@ -106,8 +111,9 @@ def run(
         png = record / "paths.png" if record is not None else Path("sim_run.png")
     if png.suffix.lower() != ".png":
         raise UserError(f"--png {png}: expected a path ending in .png")
-    if png.is_dir():
-        raise UserError(f"--png {png}: is a directory, expected a file path")
+    if record is not None:
+        check_output_dir(record, "--record")
+    check_output_file(png, "--png")
     loaded = load_mission(mission)
     steps = None
     if script is not None:
@@ -245,9 +251,11 @@ def export_map(
         raise UserError(f"--resolution: expected a positive cell size in metres, got {resolution}")
     if out.suffix.lower() not in (".yaml", ".yml"):
         raise UserError(f"--out {out}: expected a map_server YAML path ending in .yaml")
-    if out.is_dir():
-        raise UserError(f"--out {out}: is a directory, expected a file path")
+    check_output_file(out, "--out")
     loaded = load_mission(mission)
+    issue = house_grid_issue(loaded.layout(), resolution) if resolution is not None else None
+    if issue:
+        raise UserError(f"--resolution {resolution:g}: {issue}")
     grid = rasterize_house(
         loaded.layout(),
         resolution if resolution is not None else loaded.map.resolution,
@@ -271,7 +279,10 @@ def export_map(
 def serve_hsr(
     mission: Annotated[Path, typer.Argument(help="A mission YAML.", show_default=False)],
     seed: Annotated[
-        int | None, typer.Option("--seed", help="Seed (default: the mission's scenario.seed).")
+        int | None,
+        typer.Option(
+            "--seed", callback=check_seed, help="Seed (default: the mission's scenario.seed)."
+        ),
     ] = None,
     duration: Annotated[
         float | None,

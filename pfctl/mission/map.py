@@ -1,6 +1,8 @@
 """The ``map`` section: grid resolution, walls, the sensor model of Eq. 1, regions, doors and
 obstacles (§II-B), with the checks of the house's geometry: polygons are simple, regions do not
-overlap, and each door lies on the wall the two regions it joins share."""
+overlap, and each door lies on the wall the two regions it joins share; the occupancy map
+(``map.occupancy``) must be readable; and the grids made from the map must fit
+:data:`GRID_MEMORY_LIMIT` (:func:`grid_memory_issue`)."""
 
 from __future__ import annotations
 
@@ -12,7 +14,10 @@ import shapely
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from pfctl.core.mapping.grid import InverseSensorModel
+from pfctl.core.mapping.house import HouseLayout, Obstacle, Region
+from pfctl.core.mapping.walls import house_geometry
 from pfctl.mission.errors import field_error, raise_first
+from pfctl.mission.map_server import GridFileError, map_server_size
 from pfctl.mission.params import CoreSection, FromCore
 from pfctl.mission.types import (
     TOLERANCE,
@@ -24,6 +29,39 @@ from pfctl.mission.types import (
     existing_file,
     fmt_point,
 )
+
+#: Memory the grids made from one map may take together, bytes. A command builds several grids of
+#: the map's cells (occupancy, free space and clearance for planning, region masks, distance
+#: transforms, belief, frontiers); :data:`GRID_BYTES_PER_CELL` is their measured peak per cell.
+#: 2 GiB holds a 110 × 110 m map at 0.05 m; a large real home (40 × 40 m) needs an eighth of it.
+GRID_MEMORY_LIMIT = 2 * 1024**3
+#: Peak bytes per map cell of the heaviest command (``pfctl follow``), rounded up
+#: (benchmarks/README.md).
+GRID_BYTES_PER_CELL = 400
+
+
+def grid_memory_issue(width: int, height: int, resolution: float) -> str | None:
+    """Why a ``width`` × ``height`` grid of ``resolution`` metres is too big for
+    :data:`GRID_MEMORY_LIMIT`, or None if it fits."""
+    need = width * height * GRID_BYTES_PER_CELL
+    if need <= GRID_MEMORY_LIMIT:
+        return None
+    return (
+        f"the grids of a {width * resolution:.4g} × {height * resolution:.4g} m map at "
+        f"{resolution:g} m ({width} × {height} cells) need about {_gib(need)}, over the limit of "
+        f"{_gib(GRID_MEMORY_LIMIT)}; use a coarser resolution or a smaller map"
+    )
+
+
+def house_grid_issue(layout: HouseLayout, resolution: float) -> str | None:
+    """:func:`grid_memory_issue` of the house's polygons rasterised at ``resolution`` (the grid
+    of :func:`~pfctl.core.mapping.walls.rasterize_house`), or None if it fits."""
+    geometry = house_geometry(layout, resolution)
+    return grid_memory_issue(geometry.width, geometry.height, resolution)
+
+
+def _gib(n: float) -> str:
+    return f"{n / 1024**3:.3g} GiB"
 
 
 class SensorModel(CoreSection, core=InverseSensorModel):
@@ -144,6 +182,28 @@ class MapConfig(MissionModel):
             if issue:
                 issues.append((("doors", i, "segment"), issue))
         raise_first(issues)
+        return self
+
+    @model_validator(mode="after")
+    def _grids_fit(self) -> MapConfig:
+        """The occupancy map is readable, and the grids of the map fit the memory limit: the
+        polygons rasterised at ``resolution`` (the simulator, map export) and the occupancy
+        image (the robot's map)."""
+        layout = HouseLayout(
+            regions=tuple(Region(r.name, tuple(r.polygon)) for r in self.regions),
+            obstacles=tuple(Obstacle(tuple(o.polygon), o.height, o.name) for o in self.obstacles),
+        )
+        issue = house_grid_issue(layout, self.resolution)
+        if issue:
+            raise field_error(("resolution",), issue)
+        if self.occupancy is not None:
+            try:
+                width, height, resolution = map_server_size(self.occupancy)
+            except GridFileError as err:
+                raise field_error(("occupancy",), f"unreadable map: {err}") from None
+            issue = grid_memory_issue(width, height, resolution)
+            if issue:
+                raise field_error(("occupancy",), f"{self.occupancy}: {issue}")
         return self
 
 

@@ -26,7 +26,7 @@ from pfctl.core.mapping.grid import (
 )
 from pfctl.files import atomic_write_all
 
-__all__ = ["GridFileError", "load_map_server", "read_pgm", "save_map_server"]
+__all__ = ["GridFileError", "load_map_server", "map_server_size", "read_pgm", "save_map_server"]
 
 #: Pixel values written by map_saver in trinary mode.
 PGM_FREE = 254
@@ -34,6 +34,8 @@ PGM_OCCUPIED = 0
 PGM_UNKNOWN = 205
 
 _MAP_MODES = ("trinary", "scale", "raw")
+#: A PGM header (magic, comments, width, height, maxval) is read from this many first bytes.
+_HEADER_BYTES = 65536
 
 
 class GridFileError(ValueError):
@@ -208,19 +210,8 @@ def _read_yaml(path: Path) -> dict[str, Any]:
     return meta
 
 
-def read_pgm(path: str | os.PathLike[str]) -> NDArray[np.float64]:
-    """Pixels of a PGM image as floats scaled to 0..255, shape (rows, cols), first row = top.
-
-    Reads binary P5 (maxval ≤ 255: 1 byte per pixel; up to 65535: 2 bytes, big-endian) and ASCII
-    P2, with ``#`` comments in the header. Raises :class:`GridFileError` naming the file.
-    """
-    path = Path(path)
-    try:
-        data = path.read_bytes()
-    except FileNotFoundError as err:
-        raise GridFileError(f"{path}: map image not found") from err
-    except OSError as err:
-        raise GridFileError(f"{path}: cannot read map image: {err.strerror or err}") from err
+def _pgm_header(data: bytes, path: Path) -> tuple[bytes, int, int, int, int]:
+    """``(magic, width, height, maxval, offset after maxval)`` of a PGM's first bytes."""
     magic = data[:2]
     if magic not in (b"P5", b"P2"):
         shown = magic.decode("latin-1") if magic[:1] == b"P" else "not a PNM file"
@@ -246,6 +237,57 @@ def read_pgm(path: str | os.PathLike[str]) -> NDArray[np.float64]:
     width, height, maxval = tokens
     if width < 1 or height < 1 or not 0 < maxval < 65536:
         raise GridFileError(f"{path}: bad PGM header (size {width}×{height}, maxval {maxval})")
+    return magic, width, height, maxval, pos
+
+
+def map_server_size(yaml_path: str | os.PathLike[str]) -> tuple[int, int, float]:
+    """``(width, height, resolution)`` of a map_server map without decoding its pixels: the
+    YAML's ``image`` and ``resolution`` are checked as :func:`load_map_server` checks them, the
+    image's PGM header is read, and a binary image must hold all its pixels. Raises
+    :class:`GridFileError` naming the file, so a mission can refuse an unreadable or oversized
+    map before anything loads it."""
+    path = Path(yaml_path)
+    meta = _read_yaml(path)
+    image_name = _field(meta, "image", path, str)
+    resolution = _number(meta, "resolution", path)
+    if not resolution > 0:
+        raise GridFileError(f"{path}: resolution must be > 0, got {resolution}")
+    image_path = Path(image_name)
+    if not image_path.is_absolute():
+        image_path = path.parent / image_path
+    try:
+        with image_path.open("rb") as handle:
+            head = handle.read(_HEADER_BYTES)
+            size = os.fstat(handle.fileno()).st_size
+    except FileNotFoundError as err:
+        raise GridFileError(f"{image_path}: map image not found") from err
+    except OSError as err:
+        raise GridFileError(f"{image_path}: cannot read map image: {err.strerror or err}") from err
+    magic, width, height, maxval, pos = _pgm_header(head, image_path)
+    if magic == b"P5":
+        need = width * height * (2 if maxval > 255 else 1)
+        if size - pos - 1 < need:
+            raise GridFileError(
+                f"{image_path}: PGM pixel data truncated ({max(size - pos - 1, 0)} bytes, "
+                f"{need} expected)"
+            )
+    return width, height, resolution
+
+
+def read_pgm(path: str | os.PathLike[str]) -> NDArray[np.float64]:
+    """Pixels of a PGM image as floats scaled to 0..255, shape (rows, cols), first row = top.
+
+    Reads binary P5 (maxval ≤ 255: 1 byte per pixel; up to 65535: 2 bytes, big-endian) and ASCII
+    P2, with ``#`` comments in the header. Raises :class:`GridFileError` naming the file.
+    """
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError as err:
+        raise GridFileError(f"{path}: map image not found") from err
+    except OSError as err:
+        raise GridFileError(f"{path}: cannot read map image: {err.strerror or err}") from err
+    magic, width, height, maxval, pos = _pgm_header(data, path)
     count = width * height
     if magic == b"P5":
         if pos >= len(data) or not data[pos : pos + 1].isspace():

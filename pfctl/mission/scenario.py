@@ -8,7 +8,7 @@ from typing import Annotated, Any, Union
 from pydantic import AfterValidator, Discriminator, Field, Tag, model_validator
 
 from pfctl.mission.errors import raise_first, value_error
-from pfctl.mission.types import NO_BOOL, RGB, Integer, MissionModel, Name, NonNegative, Point
+from pfctl.mission.types import NO_BOOL, RGB, MissionModel, Name, NonNegative, Point, Seed
 
 
 def _route_stop_kind(value: Any) -> str | None:
@@ -106,7 +106,7 @@ class ScenarioRandomization(MissionModel):
 class ScenarioConfig(MissionModel):
     """The simulator's episode: seed, the people, and which of them is the target."""
 
-    seed: Integer = 0
+    seed: Seed = 0
     target: str | None = None
     """The name of the person to follow: one of ``people``."""
     people: tuple[Person, ...] = ()

@@ -13,6 +13,7 @@ declared once, on the field of the dataclass the section names as ``core``
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Literal
 
@@ -32,7 +33,7 @@ from pfctl.core.perception.tracking import TrackerParams
 from pfctl.core.prediction.models import SvrState
 from pfctl.mission.backend import BackendConfig
 from pfctl.mission.errors import field_error, raise_first
-from pfctl.mission.map import MapConfig
+from pfctl.mission.map import MapConfig, ObstacleSpec
 from pfctl.mission.params import CoreSection, FromCore
 from pfctl.mission.scenario import ScenarioConfig
 from pfctl.mission.tree import TreeNode, paper_tree
@@ -316,6 +317,16 @@ class BehaviorConfig(CoreSection, core=FollowerParams):
     tree: TreeNode = Field(default_factory=paper_tree)
 
 
+def _furniture_at(obstacles: Sequence[ObstacleSpec], shape: shapely.Geometry) -> str | None:
+    """``obstacle 'name'`` (or ``map.obstacles[i]``) of the first obstacle whose inside
+    ``shape`` reaches (more than touching), or None."""
+    for i, obstacle in enumerate(obstacles):
+        polygon = shapely.Polygon(obstacle.polygon)
+        if polygon.intersection(shape).area > TOLERANCE**2 or polygon.contains(shape):
+            return f"obstacle {obstacle.name!r}" if obstacle.name else f"map.obstacles[{i}]"
+    return None
+
+
 class Mission(MissionModel):
     """A whole mission file. Only ``name`` and ``map.regions`` are required."""
 
@@ -336,7 +347,8 @@ class Mission(MissionModel):
 
     @model_validator(mode="after")
     def _places_exist(self) -> Mission:
-        """The robot starts inside the house; routes name existing regions or inside points."""
+        """The robot starts inside the house, clear of the furniture; routes name existing
+        regions or points inside the house and outside the furniture."""
         issues: list[tuple[tuple[str | int, ...], str]] = []
         regions = [r.name for r in self.map.regions]
         house = shapely.union_all([shapely.Polygon(r.polygon) for r in self.map.regions])
@@ -349,6 +361,18 @@ class Mission(MissionModel):
                     f"expected a start inside the regions, got ({start.x:g}, {start.y:g})",
                 )
             )
+        elif start is not None:
+            body = shapely.Point(start.x, start.y).buffer(self.robot.radius)
+            hit = _furniture_at(self.map.obstacles, body)
+            if hit is not None:
+                issues.append(
+                    (
+                        ("robot", "start"),
+                        f"expected a start clear of the furniture, got ({start.x:g}, "
+                        f"{start.y:g}): the robot (radius {self.robot.radius:g} m) overlaps "
+                        f"{hit}",
+                    )
+                )
         for i, person in enumerate(self.scenario.people):
             for j, stop in enumerate(person.route):
                 loc = ("scenario", "people", i, "route", j)
@@ -361,6 +385,11 @@ class Mission(MissionModel):
                     issues.append(
                         (loc, f"expected a point inside the regions, got {fmt_point(stop)}")
                     )
+                elif (hit := _furniture_at(self.map.obstacles, shapely.Point(stop))) is not None:
+                    issues.append(
+                        (loc, f"expected a point outside the furniture, got {fmt_point(stop)} "
+                         f"inside {hit}")
+                    )  # fmt: skip
         for i, region in enumerate(self.scenario.randomize.hide_in):
             if region not in regions:
                 issues.append(

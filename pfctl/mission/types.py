@@ -52,6 +52,10 @@ Probability = Annotated[float, Field(gt=0, lt=1), NO_BOOL]
 """A probability in the open interval (0, 1)."""
 UnitInterval = Annotated[float, Field(ge=0, le=1), NO_BOOL]
 Integer = Annotated[int, NO_BOOL]
+SEED_MAX = 2**32 - 1
+"""The largest seed: numpy's and scikit-learn's seeds are 32-bit unsigned."""
+Seed = Annotated[int, Field(ge=0, le=SEED_MAX), NO_BOOL]
+"""A seed of the random streams: 0 to :data:`SEED_MAX`."""
 Count = Annotated[int, Field(ge=1), NO_BOOL]
 Name = Annotated[str, Field(min_length=1)]
 Identifier = Annotated[

@@ -3,6 +3,8 @@ other bins than the mission's is one line for the user naming it."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -11,6 +13,9 @@ from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.identity.params import IdentityParams
 from pfctl.core.perception.identity.profile import PROFILE_VERSION, TargetProfile
 from pfctl.errors import UserError
+from tests.conftest import run_cli
+
+HOUSE = Path(__file__).resolve().parents[2] / "missions" / "house.yaml"
 
 
 def _profile(faces: int = 2) -> TargetProfile:
@@ -34,6 +39,7 @@ def test_profile_round_trips_through_npz_and_bad_files_are_user_errors(tmp_path)
     np.savez(tmp_path / "old.npz", **{**_fields(prof), "version": np.array(PROFILE_VERSION + 1)})
     np.savez(tmp_path / "bins.npz", **{**_fields(prof), "bins": np.array([8, 4, 4])})
     np.savez(tmp_path / "part.npz", upper=prof.upper)
+    np.savez(tmp_path / "text.npz", **{**_fields(prof), "version": np.array("one")})
     obj = np.array([{"evil": 1}], dtype=object)
     np.savez(tmp_path / "pickle.npz", **{**_fields(prof), "faces": obj})
     cases = {
@@ -43,6 +49,7 @@ def test_profile_round_trips_through_npz_and_bad_files_are_user_errors(tmp_path)
         "bins.npz": "upper",
         "part.npz": "missing",
         "pickle.npz": "not a target profile",
+        "text.npz": "version: expected integers",
     }
     for name, words in cases.items():
         with pytest.raises(UserError, match=words) as err:
@@ -60,3 +67,48 @@ def test_a_profile_in_other_bins_than_the_mission_is_a_user_error() -> None:
     with pytest.raises(UserError, match=r"^t\.npz: histograms are hsv .*\(learn it again\)$"):
         check_target_profile(_profile(), params, "t.npz")
     check_target_profile(_profile(), IdentityParams())
+
+
+def _bad_profiles(tmp_path: Path) -> dict[str, tuple[Path, str]]:
+    """Files a user might pass as ``--target``, and the words their one error line says."""
+    good = _profile().to_bytes()
+    truncated = tmp_path / "truncated.npz"
+    truncated.write_bytes(good[:3000])  # head -c 3000 t.npz
+    noise = tmp_path / "noise.npz"
+    noise.write_bytes(np.random.default_rng(0).bytes(5000))
+    pickled = tmp_path / "pickled.npz"
+    np.savez(pickled, **{**_fields(_profile()), "faces": np.array([{"evil": 1}], dtype=object)})
+    return {
+        "truncated": (truncated, "damaged target profile (.npz): truncated or corrupt archive"),
+        "noise": (noise, "not a target profile: not an .npz archive"),
+        "pickled": (pickled, "not a target profile: an array holds pickled Python objects"),
+    }
+
+
+@pytest.mark.parametrize("kind", ["truncated", "noise", "pickled"])
+@pytest.mark.parametrize(
+    "command",
+    [
+        ["follow", str(HOUSE), "--backend", "sim", "--duration", "5"],
+        ["search", str(HOUSE), "--backend", "sim", "--duration", "5"],
+        ["replay", "episode.bag"],
+    ],
+    ids=["follow", "search", "replay"],
+)
+def test_a_damaged_or_foreign_target_file_is_one_line_for_every_command(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    command: list[str],
+    kind: str,
+) -> None:
+    path, words = _bad_profiles(tmp_path)[kind]
+    out = tmp_path / "out"
+    code, stdout, err = run_cli(
+        [*command, "--target", str(path), "--out", str(out)], capsys, monkeypatch
+    )
+    assert code == 2 and stdout == ""
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    assert err.startswith("pfctl: error: ") and str(path) in err and words in err, err
+    assert "allow_pickle" not in err
+    assert not out.exists()

@@ -168,3 +168,13 @@ def test_tables_csv_markdown_and_plot(records: list[dict[str, Any]]) -> None:
     png = boxplots_png(summaries, FOLLOW_METRICS, "t")
     assert png.startswith(b"\x89PNG") and len(png) > 20_000
     assert np.isfinite(summaries[1].estimates["following_rate"].mean or np.nan)
+
+
+def test_episodes_csv_round_trips_floats() -> None:
+    """A metric or wall time reads back from ``episodes.csv`` as the very float recorded."""
+    record = _record("base", 1, _follow(0.123456789012, 2, [1234.56789012345]))
+    record["timing"] = {"wall_s": 12345.678901234, "learn_wall_s": 0.1 + 0.2}
+    (row,) = csv.DictReader(io.StringIO(episodes_csv([record])))
+    assert float(row["following_rate"]) == 0.123456789012
+    assert float(row["wall_s"]) == 12345.678901234
+    assert float(row["learn_wall_s"]) == 0.1 + 0.2

@@ -109,7 +109,7 @@ def _mission_with(tmp_path: Path, old: str, new: str) -> Path:
     ("args", "message"),
     [
         (["--format", "svg"], "--format svg: expected one of ascii, dot, png, btcpp"),
-        (["--out", "/no/such/dir/t.txt"], "/no/such/dir/t.txt: cannot write"),
+        (["--out", "/no/such/dir/t.txt"], "--out /no/such/dir/t.txt: no such folder /no/such/dir"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(

@@ -94,6 +94,27 @@ def test_predict_json_out_file(
     assert 5.6 < end["x"] < 6.05 and abs(end["y"]) < 0.05  # ~95 % of 1 m/s for 3 s from x=3
 
 
+def test_predict_csv_round_trips_ros_epoch_times_and_coordinates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """ROS-epoch times (~1.73e9 s, 25 ms apart) and metre coordinates far from the origin: the
+    CSV holds the same floats as the JSON (repr-exact), none repeated."""
+    t0, x0 = 1_732_540_000.123456, 1234.56789012
+    rows = [f"{t0 + 0.025 * k!r},{x0 + 0.03 * k!r},{-0.01 * k!r}" for k in range(40)]
+    track = tmp_path / "epoch.csv"
+    track.write_text("t,x,y\n" + "\n".join(rows) + "\n", encoding="utf-8")
+    args = ["predict", str(track), "--horizon", "1", "--model", "cv"]
+    code, out, err = run_cli(args, capsys, monkeypatch)
+    assert code == 0, err
+    code, text, err = run_cli([*args, "--format", "json"], capsys, monkeypatch)
+    assert code == 0, err
+    points = json.loads(text)["points"]
+    cells = [[float(v) for v in line.split(",")] for line in out.splitlines()[1:]]
+    assert cells == [[p["t"], p["x"], p["y"]] for p in points]
+    assert len({c[0] for c in cells}) == len(cells) == 40  # 1 s at 25 ms, no repeated time
+    assert cells[0][0] > t0 + 0.025 * 39
+
+
 def test_predict_with_mission_clips_reports_region_and_plots(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -96,6 +96,12 @@ def test_replay_errors_are_one_line_and_write_nothing(
         (["replay", bag, "--scan-topic", "/nope"], "no topic /nope"),
         (["replay", bag, "--frame", "moon"], "no such frame"),
         (["replay", bag, "--no-camera", "--target", str(tmp_path / "t.npz")], "t.npz"),
+        (
+            ["replay", str(tmp_path)],
+            f"{tmp_path}: a folder but not a ROS 2 bag (no metadata.yaml); expected a ROS 1 .bag "
+            "file, a ROS 2 bag folder or its .mcap/.db3 file",
+        ),
+        (["replay", str(episode)], f"a pfctl recording: give {episode / 'episode.bag'}"),
     ]
     for args, message in cases:
         status, _, err = run_cli([*args, "--out", str(out)], capsys, monkeypatch)

@@ -151,8 +151,13 @@ def test_extends_chains_and_paths_are_relative_to_each_file(tmp_path: Path) -> N
     assert again == mission
 
 
+#: A readable 4 × 4 map image (the mission checks ``map.occupancy``'s image).
+PGM = b"P5\n4 4\n255\n" + bytes([254]) * 16
+
+
 def test_a_base_file_field_stays_relative_to_the_base(tmp_path: Path) -> None:
-    occupancy = write(tmp_path / "maps" / "house_map.yaml", "image: x.pgm\n")
+    occupancy = write(tmp_path / "maps" / "house_map.yaml", "image: x.pgm\nresolution: 0.1\n")
+    (tmp_path / "maps" / "x.pgm").write_bytes(PGM)
     write(
         tmp_path / "base.yaml",
         BASE.replace(
@@ -162,7 +167,8 @@ def test_a_base_file_field_stays_relative_to_the_base(tmp_path: Path) -> None:
     child = write(tmp_path / "sub" / "child.yaml", "extends: ../base.yaml\nname: child\n")
     assert load_mission(child).map.occupancy == occupancy.resolve()
     # a child's own relative path is relative to the child
-    write(tmp_path / "sub" / "own.yaml", "image: y.pgm\n")
+    write(tmp_path / "sub" / "own.yaml", "image: y.pgm\nresolution: 0.1\n")
+    (tmp_path / "sub" / "y.pgm").write_bytes(PGM)
     own = write(
         tmp_path / "sub" / "own_child.yaml",
         "extends: ../base.yaml\nname: own\nmap: {occupancy: own.yaml}\n",

@@ -175,6 +175,7 @@ def test_polygon_may_repeat_its_first_point_and_is_stored_open() -> None:
 def test_occupancy_is_resolved_relative_to_the_mission_file(tmp_path: Path) -> None:
     (tmp_path / "maps").mkdir()
     (tmp_path / "maps" / "house.yaml").write_text("image: house.pgm\nresolution: 0.05\n")
+    (tmp_path / "maps" / "house.pgm").write_bytes(b"P5\n4 4\n255\n" + bytes([254]) * 16)
     path = tmp_path / "m.yaml"
     path.write_text(MINIMAL.replace("map:\n", "map:\n  occupancy: maps/house.yaml\n"))
     mission = load_mission(path)
@@ -348,6 +349,14 @@ BROKEN = [
         id="target-not-among-people",
     ),
     pytest.param(
+        "target: alice",
+        "seed: -1\n  target: alice",
+        17,
+        "scenario.seed",
+        [">= 0", "got -1"],
+        id="seed-negative",
+    ),
+    pytest.param(
         "[kitchen, hall, [1.0, 4.5]]",
         "[kitchen, garage, [1.0, 4.5]]",
         21,
@@ -434,6 +443,41 @@ BROKEN = [
         "map.occupancy",
         ["maps/nowhere.yaml does not exist"],
         id="occupancy-missing",
+    ),
+    pytest.param(
+        "  doors:\n",
+        "  obstacles:\n    - {name: table, polygon: [[0.5, 4], [1.5, 4], [1.5, 5], [0.5, 5]]}\n"
+        "  doors:\n",
+        23,
+        "scenario.people[0].route[2]",
+        ["expected a point outside the furniture, got (1, 4.5) inside obstacle 'table'"],
+        id="route-point-in-furniture",
+    ),
+    pytest.param(
+        "behavior:\n",
+        "  obstacles:\n    - {name: table, polygon: [[1, 1], [2, 1], [2, 2], [1, 2]]}\n"
+        "robot:\n  start: {x: 1.5, y: 1.5}\nbehavior:\n",
+        13,
+        "robot.start",
+        ["expected a start clear of the furniture, got (1.5, 1.5)", "overlaps obstacle 'table'"],
+        id="robot-start-in-furniture",
+    ),
+    pytest.param(
+        "behavior:\n",
+        "  obstacles:\n    - {polygon: [[1, 1], [2, 1], [2, 2], [1, 2]]}\n"
+        "robot:\n  radius: 0.3\n  start: {x: 2.2, y: 1.5}\nbehavior:\n",
+        14,
+        "robot.start",
+        ["the robot (radius 0.3 m) overlaps map.obstacles[0]"],
+        id="robot-body-in-furniture",
+    ),
+    pytest.param(
+        "map:\n",
+        "map:\n  resolution: 0.0001\n",
+        3,
+        "map.resolution",
+        ["map at 0.0001 m (", "cells) need about", "over the limit of 2 GiB"],
+        id="grids-over-memory-limit",
     ),
     pytest.param(
         "behavior:\n",
@@ -598,7 +642,7 @@ def test_schema_out_writes_the_file_atomically(
     nowhere = tmp_path / "no" / "dir" / "schema.json"
     code, _, err = run_cli(["mission", "schema", "--out", str(nowhere)], capsys, monkeypatch)
     assert code == 2
-    assert_one_error_line(err, f"pfctl: error: {nowhere}: cannot write")
+    assert_one_error_line(err, f"pfctl: error: --out {nowhere}: no such folder {nowhere.parent}")
     assert not nowhere.parent.exists()
 
 
@@ -607,3 +651,135 @@ def test_subprocess_schema_is_valid_json() -> None:
     result = run_subprocess(["mission", "schema"], cwd=ROOT)
     assert result.returncode == 0, result.stderr
     assert "map" in json.loads(result.stdout)["properties"]
+
+
+# --------------------------------------------------------------------------------------------
+# the occupancy map must be readable, and every grid of the map must fit the memory limit
+# --------------------------------------------------------------------------------------------
+
+
+def _with_occupancy(tmp_path: Path, image: bytes | None) -> tuple[Path, Path]:
+    """MINIMAL with ``map.occupancy: maps/m.yaml`` (line 3) whose image is ``image`` (None: no
+    image file); (mission, image path)."""
+    maps = tmp_path / "maps"
+    maps.mkdir()
+    (maps / "m.yaml").write_text("image: m.pgm\nresolution: 0.05\norigin: [0.0, 0.0, 0.0]\n")
+    if image is not None:
+        (maps / "m.pgm").write_bytes(image)
+    mission = tmp_path / "mission.yaml"
+    mission.write_text(MINIMAL.replace("map:\n", "map:\n  occupancy: maps/m.yaml\n"))
+    return mission, maps / "m.pgm"
+
+
+@pytest.mark.parametrize(
+    ("image", "fragment"),
+    [
+        pytest.param(None, "map image not found", id="no-image"),
+        pytest.param(b"\x89PNG\r\n\x1a\n" + bytes(64), "unsupported image", id="png"),
+        pytest.param(b"P5\nten ten\n255\n", "bad PGM header", id="bad-header"),
+        pytest.param(
+            b"P5\n10 10\n255\n" + bytes(50),
+            "PGM pixel data truncated (50 bytes, 100 expected)",
+            id="truncated",
+        ),
+    ],
+)
+def test_an_unreadable_occupancy_image_is_refused_by_validate(
+    image: bytes | None,
+    fragment: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    mission, pgm = _with_occupancy(tmp_path, image)
+    code, out, err = run_cli(["mission", "validate", str(mission)], capsys, monkeypatch)
+    assert code == 2 and out == ""
+    assert_one_error_line(
+        err, f"pfctl: error: {mission}:3: map.occupancy: unreadable map: {pgm}: {fragment}"
+    )
+
+
+def test_a_readable_occupancy_map_validates(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    mission, _ = _with_occupancy(tmp_path, b"P5\n10 10\n255\n" + bytes([254]) * 100)
+    code, out, err = run_cli(["mission", "validate", str(mission)], capsys, monkeypatch)
+    assert code == 0 and out.startswith(f"OK {mission}"), err
+
+
+def test_an_oversized_occupancy_image_is_refused_without_reading_its_pixels(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A 30000 × 30000 PGM (a sparse file: 900 MB that take no disk) is refused from its
+    header alone."""
+    mission, pgm = _with_occupancy(tmp_path, b"P5\n30000 30000\n255\n")
+    with pgm.open("r+b") as handle:
+        handle.truncate(len(b"P5\n30000 30000\n255\n") + 30000 * 30000)
+    code, _, err = run_cli(["mission", "validate", str(mission)], capsys, monkeypatch)
+    assert code == 2
+    assert_one_error_line(
+        err,
+        f"pfctl: error: {mission}:3: map.occupancy: {tmp_path / 'maps' / 'm.yaml'}: the grids of "
+        "a 1500 × 1500 m map at 0.05 m (30000 × 30000 cells) need about",
+        "over the limit of 2 GiB",
+    )
+
+
+HUGE = MINIMAL.replace(
+    "[[0, 0], [3, 0], [3, 2], [0, 2]]", "[[0, 0], [1000, 0], [1000, 1000], [0, 1000]]"
+)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        pytest.param(["mission", "validate"], id="validate"),
+        pytest.param(["map", "export", "--out", "OUT/m.yaml"], id="map-export"),
+        pytest.param(["map", "render", "--png", "OUT/m.png"], id="map-render"),
+        pytest.param(["sim", "run", "--duration", "5", "--png", "OUT/s.png"], id="sim-run"),
+        pytest.param(["sim", "export-map", "--out", "OUT/m.yaml"], id="sim-export-map"),
+        pytest.param(["predict", "TRACK", "--model", "cv", "--mission"], id="predict"),
+        pytest.param(["follow", "--duration", "5", "--out", "OUT"], id="follow"),
+        pytest.param(["search", "--duration", "5", "--out", "OUT"], id="search"),
+        pytest.param(["bench", "--episodes", "1", "--out", "OUT"], id="bench"),
+    ],
+)
+def test_a_map_over_the_memory_limit_is_refused_by_every_command(
+    args: list[str],
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """1000 × 1000 m at 0.05 m: one line from the mission's validation, nothing written."""
+    mission = tmp_path / "huge.yaml"
+    mission.write_text(HUGE)
+    track = tmp_path / "t.csv"
+    track.write_text("t,x,y\n0,1,1\n0.1,1.1,1\n0.2,1.2,1\n")
+    out = tmp_path / "out"
+    words = [str(track) if a == "TRACK" else a.replace("OUT", str(out)) for a in args]
+    full = [*words, str(mission)] if "TRACK" in args else [*words[:2], str(mission), *words[2:]]
+    if args[0] in ("follow", "search", "bench"):
+        full = [args[0], str(mission), *words[1:]]
+    code, _, err = run_cli(full, capsys, monkeypatch)
+    assert code == 2, err
+    assert_one_error_line(
+        err,
+        f"pfctl: error: {mission}:2: map.resolution: the grids of a 1001 × 1001 m map at 0.05 m "
+        "(20020 × 20020 cells) need about 149 GiB, over the limit of 2 GiB",
+    )
+    assert not out.exists()
+
+
+def test_an_explicit_resolution_over_the_memory_limit_is_refused(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    for command in (["map", "export"], ["sim", "export-map"], ["map", "render"]):
+        option = "--png" if command[1] == "render" else "--out"
+        out = tmp_path / ("m.png" if option == "--png" else "m.yaml")
+        args = [*command, str(HOUSE), "--resolution", "0.0005", option, str(out)]
+        code, _, err = run_cli(args, capsys, monkeypatch)
+        assert code == 2
+        assert_one_error_line(
+            err, "pfctl: error: --resolution 0.0005: the grids of a 13 × 10 m map at 0.0005 m"
+        )
+        assert not out.exists()

@@ -247,11 +247,12 @@ def parse_frames(
 def trajectory_to_csv(
     t: FloatArray, xy: FloatArray, extra: dict[str, list[str]] | None = None
 ) -> str:
-    """``t,x,y[,extra...]`` CSV text (header first) of time-stamped points."""
+    """``t,x,y[,extra...]`` CSV text (header first) of time-stamped points; each number is
+    written as ``repr(float)``, so it reads back to the same float."""
     extra = extra or {}
     out = io.StringIO()
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(["t", "x", "y", *extra])
     for i, (ti, (x, y)) in enumerate(zip(t, xy, strict=True)):
-        writer.writerow([f"{ti:.6g}", f"{x:.4f}", f"{y:.4f}", *(v[i] for v in extra.values())])
+        writer.writerow([*(repr(float(v)) for v in (ti, x, y)), *(v[i] for v in extra.values())])
     return out.getvalue()

@@ -11,6 +11,8 @@ from __future__ import annotations
 
 import io
 import math
+import zipfile
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -170,39 +172,52 @@ class TargetProfile:
     @classmethod
     def from_bytes(cls, data: bytes) -> TargetProfile:
         """The profile in :meth:`to_bytes`'s bytes, checked; ValueError (one line: what is wrong
-        and which field) if they are not a usable profile."""
+        and which field) if they are not a usable profile: not an ``.npz`` at all ("not a target
+        profile"), a damaged archive ("damaged target profile"), or a field of the wrong kind."""
+        if not data.startswith(_ZIP_MAGIC):
+            raise ValueError(
+                "not a target profile: not an .npz archive (pfctl learn-target writes one)"
+            )
         try:
             with np.load(io.BytesIO(data), allow_pickle=False) as npz:
                 fields = {k: npz[k] for k in npz.files}
-        except (OSError, ValueError) as err:
-            raise ValueError(f"not a target profile (.npz): {err}") from None
+        except _DAMAGED as err:
+            if "pickle" in str(err):
+                raise ValueError(
+                    "not a target profile: an array holds pickled Python objects"
+                ) from None
+            raise ValueError(f"damaged target profile (.npz): {_damage(err)}") from None
         missing = {"version", "upper", "lower", "faces", "color_space", "bins"} - set(fields)
         if missing:
             raise ValueError(f"not a target profile: missing {', '.join(sorted(missing))}")
-        version = int(fields["version"])
-        if version != PROFILE_VERSION:
-            raise ValueError(f"version: expected {PROFILE_VERSION}, got {version} (learn it again)")
+        version = _integers(fields, "version")
+        if version != (PROFILE_VERSION,):
+            shown = version[0] if len(version) == 1 else list(version)
+            raise ValueError(f"version: expected {PROFILE_VERSION}, got {shown} (learn it again)")
         space = str(fields["color_space"])
         if space not in ("hsv", "rgb", "lab"):
             raise ValueError(f"color_space: expected hsv, rgb or lab, got {space!r}")
-        bins = tuple(int(b) for b in np.ravel(fields["bins"]))
+        bins = _integers(fields, "bins")
         if len(bins) != 3 or min(bins) < 1:
             raise ValueError(f"bins: expected three positive counts, got {bins}")
         size = int(np.prod(bins))
-        upper, lower = (np.asarray(fields[k], dtype=np.float64).ravel() for k in ("upper", "lower"))
+        upper, lower = (_numbers(fields, k).ravel() for k in ("upper", "lower"))
         for key, h in (("upper", upper), ("lower", lower)):
             if h.size != size or not np.all(np.isfinite(h)) or np.any(h < 0):
                 raise ValueError(f"{key}: expected {size} finite non-negative histogram bins")
-        faces = np.asarray(fields["faces"], dtype=np.float64)
+        faces = _numbers(fields, "faces")
         if faces.ndim != 2 or faces.shape[1] != EMBEDDING_SIZE or not np.all(np.isfinite(faces)):
             raise ValueError(f"faces: expected a (k, {EMBEDDING_SIZE}) array")
+        frames = _integers(fields, "frames") if "frames" in fields else (0,)
+        if len(frames) != 1:
+            raise ValueError(f"frames: expected one count, got {len(frames)} values")
         return cls(
             upper=upper,
             lower=lower,
             faces=faces,
             color_space=space,  # type: ignore[arg-type]
             bins=bins,  # type: ignore[arg-type]
-            frames=int(fields.get("frames", 0)),
+            frames=frames[0],
         )
 
     def check_params(self, params: IdentityParams, source: str = "profile") -> None:
@@ -214,6 +229,42 @@ class TargetProfile:
                 f"{source}: histograms are {self.color_space} {list(self.bins)}, the mission's "
                 f"perception.identity wants {want.color_space} {list(want.bins)} (learn it again)"
             )
+
+
+#: An ``.npz`` is a zip archive; its bytes start with a zip local-file header.
+_ZIP_MAGIC = b"PK\x03\x04"
+#: What reading the arrays of a damaged archive raises (zip structure, CRC, deflate, .npy
+#: headers, object arrays that would need pickle).
+_DAMAGED = (
+    OSError,
+    ValueError,
+    EOFError,
+    TypeError,
+    KeyError,
+    NotImplementedError,
+    zipfile.BadZipFile,
+    zlib.error,
+)
+
+
+def _damage(err: Exception) -> str:
+    if isinstance(err, zipfile.BadZipFile) and "not a zip file" in str(err):
+        return "truncated or corrupt archive"
+    return " ".join(str(err).split()) or type(err).__name__
+
+
+def _integers(fields: dict[str, np.ndarray], key: str) -> tuple[int, ...]:
+    values = np.asarray(fields[key])
+    if values.dtype.kind not in "iu":
+        raise ValueError(f"{key}: expected integers, got {values.dtype} data")
+    return tuple(int(v) for v in values.ravel())
+
+
+def _numbers(fields: dict[str, np.ndarray], key: str) -> np.ndarray:
+    values = np.asarray(fields[key])
+    if values.dtype.kind not in "iuf":
+        raise ValueError(f"{key}: expected numbers, got {values.dtype} data")
+    return values.astype(np.float64)
 
 
 def learn_profile(

@@ -88,8 +88,14 @@ def test_a_profile_in_bytes_round_trips_and_bad_bytes_are_value_errors() -> None
     back = TargetProfile.from_bytes(prof.to_bytes())
     assert np.array_equal(back.upper, prof.upper) and np.array_equal(back.faces, prof.faces)
     assert (back.color_space, back.bins, back.frames) == ("hsv", (16, 4, 4), 7)
-    with pytest.raises(ValueError, match="not a target profile"):
+    with pytest.raises(ValueError, match=r"not a target profile: not an \.npz archive"):
         TargetProfile.from_bytes(b"not a zip")
+    data = prof.to_bytes()
+    with pytest.raises(ValueError, match=r"damaged target profile .*truncated or corrupt"):
+        TargetProfile.from_bytes(data[: len(data) // 2])
+    member = data.index(b"\x93NUMPY") + 40  # inside the first array's header: its CRC fails
+    with pytest.raises(ValueError, match=r"damaged target profile .*CRC"):
+        TargetProfile.from_bytes(data[:member] + b"x" * 20 + data[member + 20 :])
 
 
 def test_a_profile_in_other_bins_than_the_mission_is_refused() -> None:
