@@ -198,11 +198,13 @@ def bench(
         raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
     campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
-    records, writer = open_results(out, campaign, resume)
+    console = Console(stderr=True)
+    records, writer = open_results(
+        out, campaign, resume, lambda line: console.print(line, highlight=False, soft_wrap=True)
+    )
     finished = {k for k, r in latest(records).items() if r["status"] == "ok"}
     todo = [s for s in campaign.specs() if s.key not in finished]
     total = len(campaign.specs())
-    console = Console(stderr=True)
     where = (
         f"Ray at {ray}" if ray is not None else f"{min(jobs, max(1, len(todo)))} worker processes"
     )

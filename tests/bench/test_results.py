@@ -140,6 +140,10 @@ def test_resume_runs_only_what_is_missing(
     calls.clear()
     code, _, err = bench(out, [*BASE_ARGS, "--resume"], capsys, monkeypatch)
     assert code == 0, err
+    # said in one line: which file, which line, that its episode runs again (issue 21, item 15)
+    [said] = [line for line in err.splitlines() if "cut short" in line]
+    assert f"{out / RESULTS_FILE}:3: the last line was cut short" in said
+    assert "its episode runs again" in said
     house = str(HOUSE_MISSION)
     assert calls == [[(house, "search.alpha=1", 2), (house, "search.alpha=2", 2)]]
     now = lines(out)
