@@ -231,12 +231,12 @@ def bench(
 
                 def on_record(record: dict[str, Any]) -> None:
                     nonlocal done
-                    with stop.holding():
+                    with stop.holding():  # a record received is kept and shown whole
                         writer.append(record)
                         records.append(record)
-                    done += 1
-                    advance(1)
-                    console.print(_episode_line(record, done, total), highlight=False)
+                        done += 1
+                        advance(1)
+                        console.print(_episode_line(record, done, total), highlight=False)
 
                 def on_retry(spec: EpisodeSpec, how: str) -> None:
                     console.print(
