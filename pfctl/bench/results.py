@@ -7,7 +7,8 @@ that finished. ``OUT/campaign.json`` holds the configuration the fingerprint was
 
 Resuming (:func:`open_results` with ``resume``) reads the records, refuses a file written by a
 campaign of another fingerprint (one line saying what changed), drops a last line cut short by a
-crash, and returns the episodes already done: those whose last record is ``ok``. Episodes that
+crash (saying so in one line: the file, the line, that its episode runs again), and returns the
+episodes already done: those whose last record is ``ok``. Episodes that
 ended in ``error`` or ``timeout`` run again; their new record follows the old one (the last record
 of an episode is the one that counts).
 """
@@ -16,7 +17,7 @@ from __future__ import annotations
 
 import json
 import os
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import IO, Any
@@ -117,6 +118,12 @@ class ResultsWriter:
             self._file = None
 
 
+def _line_count(path: Path) -> int:
+    """The number of lines of ``path`` (newlines)."""
+    with path.open("rb") as f:
+        return sum(chunk.count(b"\n") for chunk in iter(lambda: f.read(1 << 20), b""))
+
+
 def _fsync_dir(path: Path) -> None:
     try:
         fd = os.open(path, os.O_RDONLY)
@@ -131,10 +138,11 @@ def _fsync_dir(path: Path) -> None:
 
 
 def open_results(
-    out: Path, campaign: Campaign, resume: bool
+    out: Path, campaign: Campaign, resume: bool, say: Callable[[str], None] = print
 ) -> tuple[list[dict[str, Any]], ResultsWriter]:
     """Check ``out`` for ``campaign`` and get ready to append: the records already there (when
-    resuming; empty otherwise) and the writer. Writes ``campaign.json``.
+    resuming; empty otherwise) and the writer. Writes ``campaign.json``. ``say`` gets the line
+    that tells of a last line cut short and dropped.
 
     Raises:
         UserError: ``out`` is not a folder or cannot be written; results are there already and
@@ -163,6 +171,10 @@ def open_results(
                 os.truncate(results, complete)
             except OSError as err:
                 raise UserError(f"{results}: cannot repair: {err.strerror or err}") from None
+            say(
+                f"{results}:{_line_count(results) + 1}: the last line was cut short (the "
+                "campaign was stopped while writing it); dropped it, its episode runs again"
+            )
     try:
         out.mkdir(parents=True, exist_ok=True)
         atomic_write(

@@ -13,9 +13,13 @@ finished) it prints per mission and variant the mean and 95 % bootstrap interval
 ``episodes.csv`` into ``--out``.
 
 Bad options, missions or ``--vary`` values end in one line and exit status 2 before anything is
-written. Ctrl-C stops the workers, keeps the results file, writes the summary of what finished
-and exits 130; a worker process that dies ends the campaign with exit status 1 (``--resume`` runs
-what is missing).
+written. A worker process that dies (``kill -9``) has its episode run again on a new one, once;
+after a second death the episode is recorded as an error. A campaign with episodes in error
+(in this run or an earlier one of it) writes its summary and exits 1, with one line saying how
+many and where their errors are (``results.jsonl``, ``episodes.csv``); ``--resume`` runs them
+again. Ctrl-C or SIGTERM (the first one; later ones are ignored while it stops,
+:mod:`pfctl.bench.stop_signals`) stops the workers, keeps the results file, writes the summary of
+what finished and exits 130 (SIGINT) or 143 (SIGTERM) with one line saying how to continue.
 """
 
 from __future__ import annotations
@@ -32,16 +36,18 @@ from rich.console import Console
 from pfctl.app.campaign import run_campaign_episode
 from pfctl.bench.aggregate import metrics_for, summarize
 from pfctl.bench.episode import BLAS_THREAD_VARIABLES
-from pfctl.bench.plan import TASKS, Campaign, MissionVariant, load_variant, mission_digest
+from pfctl.bench.plan import (
+    TASKS,
+    Campaign,
+    EpisodeSpec,
+    MissionVariant,
+    load_variant,
+    mission_digest,
+)
 from pfctl.bench.plan import mission_labels as _labels
 from pfctl.bench.results import RESULTS_FILE, episode_key, latest, open_results
-from pfctl.bench.runner import (
-    RAY_INSTALL,
-    WorkerDiedError,
-    ray_available,
-    run_in_processes,
-    run_on_ray,
-)
+from pfctl.bench.runner import RAY_INSTALL, ray_available, run_in_processes, run_on_ray
+from pfctl.bench.stop_signals import StopSignals
 from pfctl.bench.variants import parse_vary, variants
 from pfctl.commands import check_seed
 from pfctl.errors import UserError
@@ -207,11 +213,13 @@ def bench(
     check_output_dir(out, "--out")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
     campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
-    records, writer = open_results(out, campaign, resume)
+    console = Console(stderr=True)
+    records, writer = open_results(
+        out, campaign, resume, lambda line: console.print(line, highlight=False, soft_wrap=True)
+    )
     finished = {k for k, r in latest(records).items() if r["status"] == "ok"}
     todo = [s for s in campaign.specs() if s.key not in finished]
     total = len(campaign.specs())
-    console = Console(stderr=True)
     where = (
         f"Ray at {ray}" if ray is not None else f"{min(jobs, max(1, len(todo)))} worker processes"
     )
@@ -223,40 +231,66 @@ def bench(
     for name in BLAS_THREAD_VARIABLES:  # read by numpy in the workers spawned from here on
         os.environ[name] = "1"
     done = total - len(todo)
-    interrupted = died = False
+    interrupted = False
     started = time.perf_counter()
-    try:
-        with progress_bar(console, "episodes", len(todo)) as advance:
+    stop = StopSignals()
+    with stop:  # until the summary is written: a second signal cannot cut it short
+        try:
+            with progress_bar(console, "episodes", len(todo)) as advance:
 
-            def on_record(record: dict[str, Any]) -> None:
-                nonlocal done
-                writer.append(record)
-                records.append(record)
-                done += 1
-                advance(1)
-                console.print(_episode_line(record, done, total), highlight=False)
+                def on_record(record: dict[str, Any]) -> None:
+                    nonlocal done
+                    with stop.holding():  # a record received is kept and shown whole
+                        writer.append(record)
+                        records.append(record)
+                        done += 1
+                        advance(1)
+                        console.print(_episode_line(record, done, total), highlight=False)
 
-            if ray is not None:
-                run_on_ray(todo, ray, jobs, on_record, run_campaign_episode)
-            else:
-                run_in_processes(todo, jobs, on_record, run_campaign_episode)
-    except KeyboardInterrupt:
-        interrupted = True
-    except WorkerDiedError as err:
-        died = True
-        console.print(f"pfctl: error: {err}")
-    finally:
-        writer.close()
-    wall = time.perf_counter() - started
-    ok = {k for k, r in latest(records).items() if r["status"] == "ok"}
-    left = len({s.key for s in campaign.specs()} - ok)
-    console.print(f"{len(todo)} episode(s) planned this run, {wall:.0f} s wall; {left} not done")
-    written = _write_summary(campaign, records, out, console)
-    results = [out / RESULTS_FILE] if (out / RESULTS_FILE).exists() else []
-    console.print("wrote " + ", ".join(str(p) for p in [*results, *written]))
-    if interrupted or died:
-        console.print(f"continue with: pfctl bench ... --out {out} --resume")
-        raise typer.Exit(130 if interrupted else 1)
+                def on_retry(spec: EpisodeSpec, how: str) -> None:
+                    console.print(
+                        f"{spec.mission_label} · {spec.variant} · seed {spec.seed}: the worker "
+                        f"process died ({how}); running the episode again on a new one",
+                        highlight=False,
+                        soft_wrap=True,
+                    )
+
+                if ray is not None:
+                    run_on_ray(todo, ray, jobs, on_record, run_campaign_episode)
+                else:
+                    run_in_processes(todo, jobs, on_record, run_campaign_episode, on_retry)
+        except KeyboardInterrupt:
+            interrupted = True
+        finally:
+            writer.close()
+        wall = time.perf_counter() - started
+        last = latest(records)
+        planned = {s.key for s in campaign.specs()}
+        ok = {k for k, r in last.items() if r["status"] == "ok"}
+        failed = sum(1 for k, r in last.items() if k in planned and r["status"] == "error")
+        left = len(planned - ok)
+        console.print(
+            f"{len(todo)} episode(s) planned this run, {wall:.0f} s wall; {left} not done"
+        )
+        written = _write_summary(campaign, records, out, console)
+        results = [out / RESULTS_FILE] if (out / RESULTS_FILE).exists() else []
+        console.print("wrote " + ", ".join(str(p) for p in [*results, *written]))
+    if interrupted:
+        how = stop.received.name if stop.received is not None else "SIGINT"
+        console.print(
+            f"pfctl: interrupted ({how}); continue with: pfctl bench ... --out {out} --resume",
+            highlight=False,
+            soft_wrap=True,
+        )
+        raise typer.Exit(stop.exit_code)
+    if failed:
+        console.print(
+            f"pfctl: error: {failed} of {total} episodes failed; their errors are in "
+            f"{out / RESULTS_FILE} and {out / 'episodes.csv'} (--resume runs them again)",
+            highlight=False,
+            soft_wrap=True,
+        )
+        raise typer.Exit(1)
 
 
 __all__ = ["bench", "build_campaign"]

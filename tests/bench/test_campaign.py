@@ -1,7 +1,8 @@
-"""pfctl bench end to end: a 4-episode campaign with 2 worker processes, interrupted
-with Ctrl-C and resumed, and the same campaign as Ray tasks (Ray started locally): the same
-seeds give the same per-episode metrics, and the resumed campaign ran only what had not
-finished. Short episodes (15 s simulated) keep it short."""
+"""pfctl bench end to end: a 4-episode campaign with 2 worker processes, interrupted with
+Ctrl-C pressed twice (to the whole process group, as a terminal sends it) and resumed, and the
+same campaign as Ray tasks (Ray started locally): the same seeds give the same per-episode
+metrics, and the resumed campaign ran only what had not finished. Short episodes (15 s
+simulated) keep it short."""
 
 from __future__ import annotations
 
@@ -29,6 +30,7 @@ def _default_sigint() -> None:
     # a child of a shell without job control may inherit SIGINT ignored: Python would then
     # never raise KeyboardInterrupt
     signal.signal(signal.SIGINT, signal.SIG_DFL)
+    os.setsid()  # its own process group, which a Ctrl-C reaches as a whole
 
 
 def _bench(out: Path, *extra: str) -> subprocess.Popen[str]:
@@ -89,8 +91,10 @@ def interrupted_and_resumed(tmp_path_factory: pytest.TempPathFactory) -> dict[st
             proc.kill()
             pytest.fail("no two episodes recorded in time")
         time.sleep(0.2)
-    proc.send_signal(signal.SIGINT)
-    code, first_output = _finish(proc)
+    os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C twice, 0.3 s apart
+    time.sleep(0.3)
+    os.killpg(proc.pid, signal.SIGINT)
+    code, first_output = _finish(proc)  # the output ends when the workers and their children do
     before = _records(out)
     summary_after_interrupt = (out / "summary.md").read_text() if code == 130 else ""
     resumed = _bench(out, "--resume")
@@ -113,6 +117,10 @@ def test_an_interrupted_campaign_resumes_without_rerunning_finished_episodes(
 ) -> None:
     run = interrupted_and_resumed
     assert run["code"] == 130, run["output"]
+    assert "Traceback" not in run["output"]
+    assert [line for line in run["output"].splitlines() if line.startswith("pfctl:")] == [
+        f"pfctl: interrupted (SIGINT); continue with: pfctl bench ... --out {run['out']} --resume"
+    ]
     before, after = run["before"], run["after"]
     assert 2 <= len(before) < 4, run["output"]
     assert f"{len(before)}/4 episodes" in run["summary_after_interrupt"]

@@ -1,6 +1,7 @@
 """pfctl bench's results file and --resume, with a stand-in runner (no simulation): records
 appended as episodes end, finished episodes skipped, a different configuration refused, a line
-cut short dropped, Ctrl-C keeping what finished (exit 130)."""
+cut short dropped (and said so), Ctrl-C keeping what finished (exit 130), failed episodes ending
+the campaign with exit status 1."""
 
 from __future__ import annotations
 
@@ -14,7 +15,6 @@ from typing import Any
 import pytest
 
 from pfctl import cli
-from pfctl.bench import runner
 from pfctl.bench.episode import record_header
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.bench.results import RESULTS_FILE, read_records
@@ -71,6 +71,7 @@ class FakeRunner:
         workers: int,
         on_record: Callable[[dict[str, Any]], None],
         episode: Callable[[EpisodeSpec], Any],
+        on_retry: Callable[[EpisodeSpec, str], None] | None = None,
     ) -> None:
         calls.append([s.key for s in specs])
         for i, spec in enumerate(specs):
@@ -140,6 +141,10 @@ def test_resume_runs_only_what_is_missing(
     calls.clear()
     code, _, err = bench(out, [*BASE_ARGS, "--resume"], capsys, monkeypatch)
     assert code == 0, err
+    # said in one line: which file, which line, that its episode runs again (issue 21, item 15)
+    [said] = [line for line in err.splitlines() if "cut short" in line]
+    assert f"{out / RESULTS_FILE}:3: the last line was cut short" in said
+    assert "its episode runs again" in said
     house = str(HOUSE_MISSION)
     assert calls == [[(house, "search.alpha=1", 2), (house, "search.alpha=2", 2)]]
     now = lines(out)
@@ -170,7 +175,12 @@ def test_failed_episodes_run_again_on_resume(
     out = tmp_path / "c"
     flaky = FakeRunner(status=lambda s: "error" if s.seed == 2 else "ok")
     code, _, err = bench(out, BASE_ARGS, capsys, monkeypatch, flaky)
-    assert code == 0 and "error RuntimeError: boom" in err
+    # failed episodes: the summary of what finished, exit 1 and one line (issue 21, item 8)
+    assert code == 1 and "error RuntimeError: boom" in err
+    assert err.count("pfctl: error:") == 1
+    assert f"pfctl: error: 2 of 4 episodes failed; their errors are in {out / RESULTS_FILE}" in (
+        " ".join(err.split())
+    )
     assert "2 (+2 failed)" not in (out / "summary.md").read_text()
     assert "| search.alpha=1 | 1 (+1 failed) |" in (out / "summary.md").read_text()
     calls.clear()
@@ -239,13 +249,14 @@ def test_ctrl_c_keeps_what_finished_and_exits_130(
     assert len(calls[0]) == 3 and len(lines(out)) == 4
 
 
-def test_a_dead_worker_ends_the_campaign_with_status_1(
+def test_a_campaign_whose_every_episode_fails_exits_1(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
 ) -> None:
     out = tmp_path / "c"
-    dead = FakeRunner(fail_after=2, error=runner.WorkerDiedError("a worker process died"))
-    code, _, err = bench(out, BASE_ARGS, capsys, monkeypatch, dead)
-    assert code == 1 and "a worker process died" in err and len(lines(out)) == 2
+    code, _, err = bench(out, BASE_ARGS, capsys, monkeypatch, FakeRunner(status=lambda s: "error"))
+    assert code == 1 and "4 of 4 episodes failed" in " ".join(err.split())
+    assert "Traceback" not in err and len(lines(out)) == 4
+    assert (out / "summary.md").exists()
 
 
 def test_ray_missing_is_one_line_and_writes_nothing(

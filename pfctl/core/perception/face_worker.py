@@ -27,9 +27,12 @@ process instead:
   GIL), widened on Linux so that a few crops never make :meth:`submit` wait for the child;
 - :meth:`close` (or leaving the ``with`` block) stops the child and reaps it; a worker that is
   garbage-collected or still open at interpreter exit is stopped too. The child ignores Ctrl-C
-  and SIGTERM (the parent decides when to stop) and exits by itself when its parent has died
-  (the job pipe reaches its end; it finishes the job at hand first). A child that dies is
-  reported as one line (:class:`FaceWorkerError`) by the next call.
+  and SIGTERM (the parent decides when to stop) and ends quietly when its parent has died: on
+  Linux the kernel kills it at once (``PR_SET_PDEATHSIG``, asked for when the worker is started
+  from the parent's main thread, whose end is the process's), elsewhere the job pipe reaches its
+  end (it finishes the job at hand first); a reply to a parent that is gone is dropped, never a
+  traceback. A child that dies is reported as one line (:class:`FaceWorkerError`) by the next
+  call.
 
 One worker serves one :class:`~pfctl.core.perception.identity.identifier.TargetIdentifier` at a time
 (its job keys are unique; an identifier ignores the results of jobs that are not its own).
@@ -38,6 +41,7 @@ One worker serves one :class:`~pfctl.core.perception.identity.identifier.TargetI
 from __future__ import annotations
 
 import contextlib
+import ctypes
 import math
 import multiprocessing
 import os
@@ -184,6 +188,25 @@ def _started_ignoring(signals: tuple[int, ...]) -> Iterator[None]:
         signal.pthread_sigmask(signal.SIG_UNBLOCK, signals)
 
 
+def _die_with_parent() -> bool:
+    """Have the kernel kill this process when its parent ends (Linux ``PR_SET_PDEATHSIG``; a
+    no-op elsewhere); False when the parent has already gone."""
+    parent = multiprocessing.parent_process()
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    return parent is None or parent.pid is None or os.getppid() == parent.pid
+
+
+def _reply(results: Connection, message: tuple[str, Any, Any]) -> bool:
+    """Send ``message`` to the parent; False when the parent is gone (the pipe is broken)."""
+    try:
+        results.send(message)
+    except OSError:
+        return False
+    return True
+
+
 def _serve(
     params: FaceParams,
     jobs: Connection,
@@ -191,12 +214,16 @@ def _serve(
     nice: int,
     idle: bool,
     cpus: tuple[int, ...] | None,
+    tied: bool = False,
 ) -> None:
-    """The child's main loop: load the models once, then answer jobs until told to stop."""
+    """The child's main loop: load the models once, then answer jobs until told to stop (or
+    the parent is gone). ``tied``: die with the parent (:func:`_die_with_parent`)."""
     # Ctrl-C and SIGTERM are the parent's to handle (a terminal, `timeout` and systemd signal
-    # the whole group): it stops the run and then this child; the child ends if the parent dies
+    # the whole group): it stops the run and then this child
     for signum in _PARENTS_SIGNALS:
         signal.signal(signum, signal.SIG_IGN)  # already from the start (_started_ignoring)
+    if tied and not _die_with_parent():
+        return
     _lower_priority(nice, idle, cpus)
     t0 = time.perf_counter()
     try:
@@ -205,9 +232,10 @@ def _serve(
         _models()
         encoder = FaceEncoder(params)
     except BaseException as err:  # no dlib, no model files: tell the parent, then end
-        results.send(("error", None, f"{type(err).__name__}: {err}"))
+        _reply(results, ("error", None, f"{type(err).__name__}: {err}"))
         return
-    results.send(("ready", None, time.perf_counter() - t0))
+    if not _reply(results, ("ready", None, time.perf_counter() - t0)):
+        return
     parent = multiprocessing.parent_process()
     while True:
         try:
@@ -235,9 +263,7 @@ def _serve(
             )
         except Exception as err:  # a bad job is the parent's bug: report it, keep serving
             out = ("failed", job, f"{type(err).__name__}: {err}")
-        try:
-            results.send(out)
-        except OSError:  # the parent is gone
+        if not _reply(results, out):  # the parent is gone
             return
 
 
@@ -298,6 +324,8 @@ class FaceWorker:
                 int(nice),
                 bool(idle),
                 None if cpus is None else tuple(cpus),
+                # the kernel's parent-death signal follows the starting thread, not the process
+                threading.current_thread() is threading.main_thread(),
             ),
             name="pfctl-face-worker",
             daemon=True,

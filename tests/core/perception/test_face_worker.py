@@ -157,10 +157,11 @@ def test_a_killed_child_is_one_clear_error() -> None:
         w.close()
 
 
-@pytest.mark.parametrize("ending", ["exit", "killed"])
+@pytest.mark.parametrize("ending", ["exit", "killed", "killed while loading"])
 def test_the_child_ends_with_its_parent(ending: str) -> None:
     """A parent that exits without closing the worker does not hang; one that is killed
-    leaves no worker behind."""
+    (kill -9 of a bench worker), even while the child still loads the models, leaves no
+    worker behind and no traceback on stderr (issue 21, item 9)."""
     script = textwrap.dedent(
         f"""
         import os, signal, sys
@@ -169,18 +170,21 @@ def test_the_child_ends_with_its_parent(ending: str) -> None:
 
         if __name__ == "__main__":
             w = FaceWorker()
-            w.wait_ready()
-            w.submit(1, astronaut(), {HEAD})
+            if {ending!r} != "killed while loading":
+                w.wait_ready()
+                w.submit(1, astronaut(), {HEAD})
             print(w.pid, flush=True)
-            if {ending!r} == "killed":
+            if {ending!r} != "exit":
                 os.kill(os.getpid(), signal.SIGKILL)
         """
     )
+    # the child inherits stderr: run() returns once every process holding it has ended
     done = subprocess.run(
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=60, cwd=ROOT
     )
     assert done.returncode == (0 if ending == "exit" else -signal.SIGKILL), done.stderr
     assert _wait_gone(int(done.stdout.split()[0]))
+    assert done.stderr == ""
 
 
 # -- the identifier with a worker -----------------------------------------------------------------
