@@ -44,8 +44,9 @@ class Expect:
         ``names``; the working folder is unchanged (no partial output).
       * ``error_or_run``: as ``error``, or the command runs normally (exit 0) — for values such
         as a negative seed that a command may reasonably accept.
-      * ``interrupt``: exit ``code`` (130 SIGINT, 143 SIGTERM) with one line on stderr; every
-        path of ``outputs`` exists and parses (JSON, JSON lines, CSV, PNG by extension).
+      * ``interrupt``: exit ``code`` (130 SIGINT, 143 SIGTERM) with one line on stderr saying so
+        (other log lines allowed); every path of ``outputs`` exists and parses (JSON, JSON
+        lines, CSV, PNG by extension).
       * ``warn``: exit 0; stderr names every string of ``names`` (a repaired input said aloud).
       * ``survive``: exit 0 although a worker was killed; ``outputs`` exist and parse, and
         ``results.jsonl`` holds ``records`` episodes.
@@ -649,6 +650,9 @@ def _mission_cases() -> list[Case]:
     return c
 
 
+NOOK_GARAGE = "nook,garage=1,0.2;1,0.8"
+
+
 def _map_cases() -> list[Case]:
     ex, sx, rd, an = "map export", "sim export-map", "map render", "map annotate"
     bad = {"m.yaml": edited("robot.radius", -1)}
@@ -759,7 +763,7 @@ def _map_cases() -> list[Case]:
         _err(
             "ma-door-unknown-region",
             an,
-            [M, "--door", "kitchen,garage=1,4;2,4", "--out", "o.yaml"],
+            [M, "--region", "nook=0,0;1,0;1,1;0,1", "--door", NOOK_GARAGE, "--out", "o.yaml"],
             ["garage"],
         ),
         _err(
@@ -1396,7 +1400,7 @@ def _predict_cases() -> list[Case]:
             timeout=60,
             why="issue 21 item 5",
         ),
-        _err("pe-missing", e, ["gone"], ["gone"]),
+        _err("pe-missing", e, ["gone", "--fps", "2.5"], ["gone"]),
         _err("pe-empty-dir", e, ["d", "--fps", "2.5"], ["d"], {"d/.keep": ""}),
         _err(
             "pe-jobs-zero",

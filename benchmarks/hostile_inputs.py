@@ -9,8 +9,9 @@ address-space limit (RLIMIT_AS) and a timeout, and is checked against what the R
 
 * bad input: exit 2, stderr exactly one line ``pfctl: error: ...`` naming the file, option or
   field, no traceback, no partial output (the case's folder unchanged);
-* interruption: exit 130 (SIGINT) or 143 (SIGTERM) with one line, the outputs measured so far
-  written and parseable;
+* interruption: exit 130 (SIGINT) or 143 (SIGTERM) with one line saying so (a ``pfctl:`` line or
+  one naming the interruption; ``bench`` keeps its log lines), the outputs measured so far written
+  and parseable;
 * always: finished within the timeout and memory limit, no process of the command left behind.
 
 Interruption cases wait for the run to start by reading the progress bar (forced on with
@@ -81,6 +82,7 @@ class Outcome:
     skipped: str = ""
     exit: int | None = None
     seconds: float = 0.0
+    cpu_seconds: float = 0.0
     max_rss_mb: float = 0.0
     stderr: str = ""
     stdout_tail: str = ""
@@ -94,6 +96,7 @@ class Run:
     stdout: str
     stderr: str
     seconds: float
+    cpu_seconds: float
     max_rss_mb: float
     timed_out: bool
     leftover: list[str]
@@ -280,6 +283,7 @@ def run_process(case: Case, argv: list[str], ws: Path) -> Run:
         stdout=out.decode("utf-8", "replace"),
         stderr=err.decode("utf-8", "replace"),
         seconds=seconds,
+        cpu_seconds=rusage.ru_utime + rusage.ru_stime if rusage else 0.0,
         max_rss_mb=rusage.ru_maxrss / 1024 if rusage else 0.0,
         timed_out=timed_out,
         leftover=described,
@@ -329,6 +333,14 @@ def stderr_lines(text: str) -> list[str]:
     plain = ANSI.sub("", text)
     lines = [ln.strip() for ln in re.split(r"[\r\n]", plain)]
     return [ln for ln in lines if ln and not any(c in ln for c in BAR_CHARS)]
+
+
+def interruption_lines(lines: list[str]) -> list[str]:
+    """The lines that tell the user the run was interrupted: ``pfctl: ...`` lines and lines
+    naming the interruption. (A command whose normal output is a log on stderr, like ``bench``,
+    keeps its log; the one line is the interruption's.)"""
+    words = ("interrupt", "terminated", "sigterm", "sigint", "ctrl-c")
+    return [ln for ln in lines if ln.startswith("pfctl:") or any(w in ln.lower() for w in words)]
 
 
 def parses(path: Path) -> str:
@@ -393,8 +405,10 @@ def judge(
     problems: list[str] = []
     if run.timed_out:
         problems.append(f"timeout after {case.timeout:.0f} s")
-    if "MemoryError" in run.stderr or (run.exit == -signal.SIGKILL and not run.timed_out):
+    if "MemoryError" in run.stderr:
         problems.append(f"memory limit {case.memory_mb} MB hit")
+    if run.exit is not None and run.exit < 0 and not run.timed_out:
+        problems.append(f"died of {signal.Signals(-run.exit).name}")
     if "Traceback" in run.stderr or "Traceback" in run.stdout:
         problems.append("traceback")
     if run.leftover:
@@ -422,8 +436,9 @@ def judge(
     elif kind == "interrupt":
         if run.exit != case.expect.code:
             problems.append(f"exit {run.exit}, not {case.expect.code}")
-        if len(lines) != 1:
-            problems.append(f"{len(lines)} stderr lines, not 1")
+        said = interruption_lines(lines)
+        if len(said) != 1:
+            problems.append(f"{len(said)} lines say it was interrupted, not 1")
         for name in case.expect.outputs:
             why = parses(ws / name)
             if why:
@@ -483,6 +498,7 @@ def run_case(case: Case, work: Path, shared: Shared) -> Outcome:
     outcome.ok, outcome.got, outcome.reason = judge(case, run, ws, before)
     outcome.exit = run.exit
     outcome.seconds = round(run.seconds, 1)
+    outcome.cpu_seconds = round(run.cpu_seconds, 1)
     outcome.max_rss_mb = round(run.max_rss_mb, 1)
     outcome.stderr = run.stderr[-3000:]
     outcome.stdout_tail = run.stdout[-500:]
@@ -666,7 +682,11 @@ def main(argv: list[str] | None = None) -> int:
             shutil.rmtree(work, ignore_errors=True)
     print(table(outcomes))
     elapsed = time.monotonic() - t0
-    print(f"({elapsed:.0f} s, --jobs {args.jobs}, interruptions {signal_jobs} at a time)")
+    cpu = sum(o.cpu_seconds for o in outcomes)
+    print(
+        f"({elapsed:.0f} s wall, {cpu:.0f} s CPU in the cases, --jobs {args.jobs}, "
+        f"interruptions {signal_jobs} at a time)"
+    )
     if args.json:
         args.json.write_text(
             json.dumps([asdict(o) for o in outcomes], indent=2) + "\n", encoding="utf-8"

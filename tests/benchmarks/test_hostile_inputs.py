@@ -81,8 +81,12 @@ def test_stderr_lines_drop_the_progress_bar_and_colour() -> None:
     assert hostile.stderr_lines(text) == ["pfctl: interrupted"]
 
 
+def catalogue_png() -> bytes:
+    return cases.png_bytes()
+
+
 def _run(stderr: str, exit: int) -> object:
-    return hostile.Run(exit, "", stderr, 1.0, 50.0, False, [], [])
+    return hostile.Run(exit, "", stderr, 1.0, 1.0, 50.0, False, [], [])
 
 
 def test_judge_wants_one_error_line_naming_the_option_or_its_value(tmp_path: Path) -> None:
@@ -120,6 +124,13 @@ def test_judge_of_an_interruption_parses_the_outputs(tmp_path: Path) -> None:
     (tmp_path / "o" / "metrics.json").write_text('{"a": ')
     ok, _, why = hostile.judge(case, _run("pfctl: interrupted\n", 130), tmp_path, set())
     assert not ok and "metrics.json does not parse" in why and "p.png missing" in why
+    (tmp_path / "o" / "metrics.json").write_text("{}")
+    (tmp_path / "o" / "p.png").write_bytes(catalogue_png())
+    log = "[1/3] house · seed 1: following 77%\npfctl: interrupted; 2 episodes not done\n"
+    ok, _, why = hostile.judge(case, _run(log, 130), tmp_path, set())
+    assert ok, why
+    ok, _, why = hostile.judge(case, _run("", -15), tmp_path, set())
+    assert not ok and "died of SIGTERM" in why and "0 lines say" in why
 
 
 def test_a_signalled_run_waits_for_progress_and_finds_leftover_children(tmp_path: Path) -> None:
