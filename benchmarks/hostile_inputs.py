@@ -54,6 +54,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from hostile_catalogue import BENCH_ARGS, ROOT, Case, catalogue
 
 ANSI = re.compile(r"\x1b\[[0-9;?]*[ -/]*[@-~]|\x1b\][^\x07]*\x07|\x1b[()][A-Z0-9]")
+CURSOR = re.compile(r"\x1b\[[0-9;]*[A-HJK]")  # a redraw: what follows starts a new line
 PROGRESS = re.compile(r"(\d+(?:\.\d+)?)/(\d+)\s")
 BAR_CHARS = ("━", "╸", "╺")
 
@@ -330,17 +331,23 @@ def snapshot(ws: Path) -> set[tuple[str, int, int]]:
 
 def stderr_lines(text: str) -> list[str]:
     """The lines a user reads on stderr: ANSI codes and progress-bar redraws removed."""
-    plain = ANSI.sub("", text)
+    plain = ANSI.sub("", CURSOR.sub("\n", text))
     lines = [ln.strip() for ln in re.split(r"[\r\n]", plain)]
     return [ln for ln in lines if ln and not any(c in ln for c in BAR_CHARS)]
 
 
 def interruption_lines(lines: list[str]) -> list[str]:
     """The lines that tell the user the run was interrupted: ``pfctl: ...`` lines and lines
-    naming the interruption. (A command whose normal output is a log on stderr, like ``bench``,
-    keeps its log; the one line is the interruption's.)"""
+    naming the interruption, not a traceback's ``KeyboardInterrupt``. (A command whose normal
+    output is a log on stderr, like ``bench``, keeps its log; the one line is the
+    interruption's.)"""
     words = ("interrupt", "terminated", "sigterm", "sigint", "ctrl-c")
-    return [ln for ln in lines if ln.startswith("pfctl:") or any(w in ln.lower() for w in words)]
+    return [
+        ln
+        for ln in lines
+        if ln.startswith("pfctl:")
+        or ("KeyboardInterrupt" not in ln and any(w in ln.lower() for w in words))
+    ]
 
 
 def parses(path: Path) -> str:

@@ -79,6 +79,8 @@ def test_stderr_lines_drop_the_progress_bar_and_colour() -> None:
         "\x1b[31mpfctl: interrupted\x1b[0m\n"
     )
     assert hostile.stderr_lines(text) == ["pfctl: interrupted"]
+    after_bar = "episodes ━━━╺━━ 1/3 -:--:--\x1b[2K[1/3] house: following 77.5%\n"
+    assert hostile.stderr_lines(after_bar) == ["[1/3] house: following 77.5%"]
 
 
 def catalogue_png() -> bytes:
