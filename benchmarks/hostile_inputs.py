@@ -436,6 +436,9 @@ def judge(
                 missing = [n for n in case.expect.names if not names(lines[0], n, case.argv)]
                 if missing:
                     problems.append(f"does not name {', '.join(missing)}")
+                said = [w for w in case.expect.avoid if w in lines[0]]
+                if said:
+                    problems.append(f"says {', '.join(said)}")
             after = snapshot(ws)
             if after != before:
                 changed = sorted({p for p, *_ in after ^ before})

@@ -104,6 +104,13 @@ def test_judge_wants_one_error_line_naming_the_option_or_its_value(tmp_path: Pat
     )
     assert ok, why
     box = "Usage: pfctl\nTry 'pfctl --help'\n╭─ Error ─╮\n│ bad │\n╰─────╯\n"
+    misled = cases.Case(
+        "y", "follow", ("follow",), cases.Expect("error", ("t.npz",), avoid=("pickle",))
+    )
+    ok, _, why = hostile.judge(
+        misled, _run("pfctl: error: t.npz: use allow_pickle\n", 2), tmp_path, before
+    )
+    assert not ok and "says pickle" in why
     ok, _, why = hostile.judge(case, _run(box, 2), tmp_path, before)
     assert not ok and "stderr lines" in why
     (tmp_path / "f.png").write_bytes(b"partial")
