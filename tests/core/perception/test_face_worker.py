@@ -34,12 +34,14 @@ RED, NAVY, GREY = (200, 30, 40), (40, 40, 120), (90, 90, 90)
 TARGET_FACE, OTHER_FACE = 20, 77  # two LFW faces far apart in dlib's embedding space
 #: The astronaut's face and a head region around it (as a person detector would give).
 HEAD = (150, 50, 290, 190)
+#: How long a child may take to load dlib's models: seconds when idle, minutes on a busy machine.
+LOADING_S = 300.0
 
 
 @pytest.fixture(scope="module")
 def worker() -> Iterator[FaceWorker]:
     with FaceWorker(FaceParams()) as w:
-        w.wait_ready()
+        w.wait_ready(LOADING_S)
         yield w
 
 
@@ -143,7 +145,7 @@ def test_close_stops_the_child_and_the_worker_says_so_after() -> None:
 def test_a_killed_child_is_one_clear_error() -> None:
     w = FaceWorker(FaceParams())
     try:
-        w.wait_ready()
+        w.wait_ready(LOADING_S)
         assert w.submit(1, astronaut(), HEAD)
         assert w.pid is not None
         os.kill(w.pid, signal.SIGKILL)
@@ -171,7 +173,7 @@ def test_the_child_ends_with_its_parent(ending: str) -> None:
         if __name__ == "__main__":
             w = FaceWorker()
             if {ending!r} != "killed while loading":
-                w.wait_ready()
+                w.wait_ready({LOADING_S})
                 w.submit(1, astronaut(), {HEAD})
             print(w.pid, flush=True)
             if {ending!r} != "exit":
@@ -180,7 +182,7 @@ def test_the_child_ends_with_its_parent(ending: str) -> None:
     )
     # the child inherits stderr: run() returns once every process holding it has ended
     done = subprocess.run(
-        [sys.executable, "-c", script], capture_output=True, text=True, timeout=60, cwd=ROOT
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=LOADING_S, cwd=ROOT
     )
     assert done.returncode == (0 if ending == "exit" else -signal.SIGKILL), done.stderr
     assert _wait_gone(int(done.stdout.split()[0]))
