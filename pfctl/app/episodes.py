@@ -22,6 +22,7 @@ from rich.progress import BarColumn, Progress, TextColumn
 from pfctl.app.follower import EpisodeResult, build_follower, run_follower, static_map
 from pfctl.app.perception import build_perception, identity_params
 from pfctl.app.profiles import check_target_profile, load_target_profile
+from pfctl.app.spill import spill_log
 from pfctl.core.episode import EpisodeLog, TickRecord
 from pfctl.core.mapping.grid import FREE
 from pfctl.core.metrics import MetricParams, search_metrics
@@ -169,6 +170,7 @@ def run_episode(
         if identifier is not None and identifier.worker is not None:
             identifier.worker.wait_ready()
         log = EpisodeLog(target_name=mission.scenario.target)
+        spill_log(log)  # an episode of hours keeps its log in a file, not in memory
         follower = build_follower(mission, robot, perception, log)
         params = metric_params(mission)
 

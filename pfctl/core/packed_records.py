@@ -7,12 +7,17 @@ stores each record as one fixed-size row instead (its numbers as float64/int64, 
 strings as indices into a :class:`StringTable`) in chunks of :data:`CHUNK_ROWS` rows, and makes the
 record again when it is read. What it stores and how is a :class:`RecordCodec`'s; the sequence is
 the same to its readers as a list of the records.
+
+Packed, a tick still costs a few hundred bytes. Given a :class:`ChunkStore` (:meth:`spill_to`),
+each chunk that fills up is handed to it, and the store gives back an array to use instead, e.g. a
+memory map of the rows written to a file (:mod:`pfctl.app.spill`): a run of hours then keeps only
+the chunk being filled in memory, and reads the others back when they are read.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator, Sequence
-from typing import Any, Generic, TypeVar, overload
+from typing import Any, Generic, Protocol, TypeVar, overload
 
 import numpy as np
 
@@ -65,6 +70,14 @@ class RecordCodec(Generic[R]):
         raise NotImplementedError
 
 
+class ChunkStore(Protocol):
+    """Where full chunks go (module docstring)."""
+
+    def put(self, chunk: np.ndarray) -> np.ndarray:
+        """Keep ``chunk``'s rows; an array of the same rows (writable) to use in its place."""
+        ...
+
+
 class PackedRecords(Sequence[R]):
     """A list-like sequence of records stored by ``codec`` (module docstring): ``append``,
     ``extend``/``+=``, ``pop`` of the last one, item assignment, indexing and slices (a slice is
@@ -74,6 +87,7 @@ class PackedRecords(Sequence[R]):
         self._codec = codec
         self._chunks: list[np.ndarray] = []
         self._length = 0
+        self._store: ChunkStore | None = None
         self.extend(records)
 
     def __len__(self) -> int:
@@ -113,6 +127,8 @@ class PackedRecords(Sequence[R]):
         """Add ``record`` at the end."""
         row = self._length % CHUNK_ROWS
         if row == 0:
+            if self._chunks and self._store is not None:
+                self._chunks[-1] = self._store.put(self._chunks[-1])
             self._chunks.append(np.empty(CHUNK_ROWS, dtype=self._codec.dtype))
         self._chunks[-1][row] = self._codec.encode(record)
         self._length += 1
@@ -144,6 +160,20 @@ class PackedRecords(Sequence[R]):
     def __repr__(self) -> str:
         return f"PackedRecords({list(self)!r})"
 
+    def spill_to(self, store: ChunkStore) -> None:
+        """From now on hand each chunk that fills up to ``store`` (module docstring); the full
+        ones already here go now."""
+        self._store = store
+        full = self._length // CHUNK_ROWS
+        for i in range(full if self._length % CHUNK_ROWS else full - 1):
+            self._chunks[i] = store.put(self._chunks[i])
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        state["_chunks"] = [np.array(chunk) for chunk in self._chunks]  # the rows, not a map
+        state["_store"] = None
+        return state
+
     @property
     def codec(self) -> RecordCodec[R]:
         """How the records are stored (its string table, nested stores)."""
@@ -171,6 +201,7 @@ def packed_factory(codec: Callable[[], RecordCodec[R]]) -> Callable[[], PackedRe
 __all__ = [
     "CHUNK_ROWS",
     "NONE_INDEX",
+    "ChunkStore",
     "PackedRecords",
     "RecordCodec",
     "StringTable",

@@ -63,3 +63,28 @@ def test_a_row_is_a_few_bytes_and_a_string_is_stored_once() -> None:
     table = StringTable()
     assert [table.encode(s) for s in ("a", "b", "a", None)] == [0, 1, 0, -1]
     assert table.decode_all(np.array([1, -1, 0])) == ["b", None, "a"]
+
+
+class ListStore:
+    """A chunk store that keeps copies, to see what was handed over."""
+
+    def __init__(self) -> None:
+        self.chunks: list[np.ndarray] = []
+
+    def put(self, chunk: np.ndarray) -> np.ndarray:
+        self.chunks.append(chunk.copy())
+        return self.chunks[-1]
+
+
+def test_full_chunks_go_to_the_store_and_read_back_the_same() -> None:
+    given = records(3 * CHUNK_ROWS + 7)
+    store = PackedRecords(PairCodec(), given[: CHUNK_ROWS + 3])
+    chunks = ListStore()
+    store.spill_to(chunks)
+    assert len(chunks.chunks) == 1  # the one already full; the one being filled stays
+    store.extend(given[CHUNK_ROWS + 3 :])
+    assert len(chunks.chunks) == 3
+    assert store == given and store.column("value").tolist() == [v for _, v in given]
+    store[5] = ("erin", 3.0)
+    assert store[5] == ("erin", 3.0) and chunks.chunks[0][5]["value"] == 3.0
+    assert pickle.loads(pickle.dumps(store))[5] == ("erin", 3.0)
