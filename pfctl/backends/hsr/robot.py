@@ -500,6 +500,7 @@ class HsrRobot:
         deadline = time.monotonic() + timeout
         published: set[str] = set()
         next_query = 0.0
+        looked_again = False
         while True:
             now = time.monotonic()
             if now >= next_query:
@@ -507,6 +508,10 @@ class HsrRobot:
                 if not self.use_sim_time:
                     self._switch_to_sim_time()
             missing = self._missing(published)
+            if not missing and not looked_again:
+                # the data may have come before the last query saw the optional topics'
+                # publishers (a simulator started after us): ask the master once more
+                published, next_query, looked_again = self._published(), now + 0.5, True
             pending = [] if missing else self._optional_pending(published)
             if not missing and not pending:
                 if not self.use_sim_time and self._switch_to_sim_time():
