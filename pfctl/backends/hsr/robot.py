@@ -29,7 +29,9 @@ tf, publishes the base and head commands, and drives ``move_base`` through actio
   published again (every :data:`LOST_ZERO_PERIOD`), and the next :meth:`HsrRobot.observe` /
   :meth:`HsrRobot.step` raises :class:`~pfctl.core.robot.RobotLostError` (``command`` never
   raises). Zero velocity is also published on :meth:`HsrRobot.close`, on any exception inside
-  ``step``/``observe`` (Ctrl-C too), and at interpreter exit.
+  ``step``/``observe`` (Ctrl-C too), and at interpreter exit. Base and head commands, goals
+  and log lines go out on one thread of their own (:mod:`~pfctl.backends.hsr.call_thread`),
+  so a Ctrl-C never lands inside rospy's publish (where it would be lost, or leave a lock held).
 
 Errors at start are :class:`RobotConnectionError` (a :class:`~pfctl.errors.UserError`: one line
 naming the master or exactly what is missing); data the robot sends that cannot be read is
@@ -51,6 +53,7 @@ from dataclasses import replace
 from typing import Any
 
 from pfctl.backends.hsr import convert
+from pfctl.backends.hsr.call_thread import CallThread
 from pfctl.backends.hsr.config import HsrConfig
 from pfctl.backends.hsr.master import MASTER_ERRORS, MasterError, check_master, master_proxy
 from pfctl.backends.hsr.person_labels import label_detector
@@ -262,6 +265,8 @@ class HsrRobot:
         self._clock_started = False
         self._last_pose = Pose2D(0.0, 0.0, 0.0)
 
+        # publishing, goals and logging run on this thread: a Ctrl-C never splits them
+        self._calls = CallThread("pfctl-hsr-calls")
         try:
             self._setup(actionlib)
             self._connect(timeout)
@@ -325,8 +330,9 @@ class HsrRobot:
                 self._on_truth_collisions,
                 queue_size=1,
             )
-        # The base command is published synchronously (no queue_size: written to the socket in
-        # the caller's thread), so the zero sent by close() is delivered before we unregister.
+        # The base command is published synchronously (no queue_size: written to the socket by
+        # the call thread while the caller waits), so the zero sent by close() is delivered
+        # before we unregister.
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", SyntaxWarning)
             self._cmd_pub = rospy.Publisher(cfg.command_velocity, geometry.Twist)
@@ -364,7 +370,7 @@ class HsrRobot:
         with listener.last_update_lock:  # of a bag and clear the buffer (the static laser too)
             listener.last_update = self._rospy.Time(0)
         self._follow_clock()
-        self._rospy.loginfo("pfctl: /use_sim_time was set: following /clock")
+        self._log("loginfo", "pfctl: /use_sim_time was set: following /clock")
         return True
 
     # -- callbacks (rospy's threads) ------------------------------------------------------------
@@ -496,12 +502,13 @@ class HsrRobot:
         return pending
 
     def _connect(self, timeout: float) -> None:
-        rospy, cfg = self._rospy, self.config
+        cfg = self.config
         deadline = time.monotonic() + timeout
         published: set[str] = set()
         next_query = 0.0
         missing = ["the list of topics from the master"]
         pending: list[str] = []
+        looked_again = False
         try:
             while True:
                 now = time.monotonic()
@@ -510,6 +517,10 @@ class HsrRobot:
                     if not self.use_sim_time:
                         self._switch_to_sim_time()
                 missing = self._missing(published)
+                if not missing and not looked_again:
+                    # the data may have come before the last query saw the optional topics'
+                    # publishers (a simulator started after us): ask the master once more
+                    published, next_query, looked_again = self._published(), now + 0.5, True
                 pending = [] if missing else self._optional_pending(published)
                 if not missing and not pending:
                     if not self.use_sim_time and self._switch_to_sim_time():
@@ -521,7 +532,7 @@ class HsrRobot:
                             f"{'; '.join(missing)} after {timeout:g} s "
                             f"(ROS_MASTER_URI={self.master_uri})"
                         )
-                    rospy.logwarn("pfctl: going on without %s", ", ".join(pending))
+                    self._log("logwarn", "pfctl: going on without %s", ", ".join(pending))
                     break
                 time.sleep(0.02)
         except Interrupted as err:  # Ctrl-C or SIGTERM while waiting: say what for
@@ -531,7 +542,8 @@ class HsrRobot:
             )
             raise
         if not self._nav_ready:
-            rospy.logwarn(
+            self._log(
+                "logwarn",
                 "pfctl: no move_base action server on %s: navigation goals will abort",
                 cfg.move_base,
             )
@@ -569,7 +581,7 @@ class HsrRobot:
         thread.join(2.0)
         if thread.is_alive() or errors:
             why = errors[0] if errors else "no answer in 2 s"
-            self._rospy.logwarn("pfctl: %s failed: %s", name, why)
+            self._log("logwarn", "pfctl: %s failed: %s", name, why)
 
     # -- time -----------------------------------------------------------------------------------
 
@@ -678,7 +690,10 @@ class HsrRobot:
         return None
 
     def _publish(self, twist: Twist2D) -> None:
-        """Publish a base command (the caller holds ``_cmd_lock``)."""
+        """Publish a base command (the caller holds ``_cmd_lock``) on the call thread."""
+        self._calls.call(self._publish_now, twist)
+
+    def _publish_now(self, twist: Twist2D) -> None:
         try:
             self._cmd_pub.publish(convert.twist_to_msg(twist))
         except Exception as err:  # a closed topic during shutdown: nothing left to command
@@ -696,7 +711,7 @@ class HsrRobot:
                 self._lost = reason
             self._publish(STOP)
         if first:
-            self._rospy.logerr("pfctl: %s; the base was stopped", reason)
+            self._log("logerr", "pfctl: %s; the base was stopped", reason)
             self._cancel_goal()
             with self._tick:
                 self._tick.notify_all()
@@ -742,7 +757,11 @@ class HsrRobot:
     def _warn_once(self, key: str, message: str) -> None:
         if key not in self._warned:
             self._warned.add(key)
-            self._rospy.logwarn(message)
+            self._log("logwarn", message)
+
+    def _log(self, level: str, message: str, *args: Any) -> None:
+        """rospy's ``level`` (``logwarn``, ...) on the call thread (logging takes locks too)."""
+        self._calls.call(getattr(self._rospy, level), message, *args)
 
     # -- the Robot port -------------------------------------------------------------------------
 
@@ -789,7 +808,8 @@ class HsrRobot:
         now = self._head or HeadState()
         move = max(abs(pan - now.pan), abs(tilt - now.tilt))
         duration = max(self.period, move / rc.head_max_speed)
-        self._head_pub.publish(convert.head_target_to_trajectory(HeadTarget(pan, tilt), duration))
+        msg = convert.head_target_to_trajectory(HeadTarget(pan, tilt), duration)
+        self._calls.call(self._head_pub.publish, msg)
 
     def _server_ready(self) -> bool:
         """The move_base action server is connected (actionlib's own test, without waiting)."""
@@ -827,7 +847,7 @@ class HsrRobot:
         target.header.frame_id = self.config.map_frame
         target.header.stamp = self._rospy.get_rostime()
         target.pose = convert.pose2d_to_pose(goal)
-        self._nav.send_goal(mb.MoveBaseGoal(target_pose=target))
+        self._calls.call(self._nav.send_goal, mb.MoveBaseGoal(target_pose=target))
         self._goal_sent, self._nav_local = True, None
 
     def nav_status(self) -> NavStatus:
@@ -845,7 +865,7 @@ class HsrRobot:
         """Cancel the goal if it is still pending or active; it reads PREEMPTED from now on."""
         if self._goal_active():
             with contextlib.suppress(Exception):
-                self._nav.cancel_goal()
+                self._calls.call(self._nav.cancel_goal)
             self._nav_local = NavStatus.PREEMPTED
 
     def cancel(self) -> None:
@@ -1073,6 +1093,7 @@ class HsrRobot:
         for thread in self._threads:
             if thread is not threading.current_thread():
                 thread.join(timeout=2.0)
+        self._calls.close()  # what was handed over (the zero of close()) goes out first
         with self._cmd_lock:  # no publish may be under way while the topics go
             for handle in self._handles:
                 with contextlib.suppress(Exception):

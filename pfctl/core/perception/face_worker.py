@@ -9,7 +9,8 @@ process instead:
 
 - the child is started with the ``spawn`` start method (the parent may hold PyBullet, which must
   not be forked), loads the three dlib models **once**, and serves jobs until it is closed;
-- it lowers its own priority (``os.nice``, and Linux's ``SCHED_IDLE`` policy when ``idle``), so on
+- once the models are loaded (at normal priority: the parent waits for them), it lowers its own
+  priority (``os.nice``, and Linux's ``SCHED_IDLE`` policy when ``idle``), so on
   one core the control loop preempts it at once and it runs in the loop's idle time; ``cpus``
   pins it (as a benchmark pins the loop);
 - with ``idle``, a job that arrives while the parent is running (the loop submits mid-tick) is
@@ -224,7 +225,6 @@ def _serve(
         signal.signal(signum, signal.SIG_IGN)  # already from the start (_started_ignoring)
     if tied and not _die_with_parent():
         return
-    _lower_priority(nice, idle, cpus)
     t0 = time.perf_counter()
     try:
         from pfctl.core.perception.faces import _models
@@ -234,6 +234,9 @@ def _serve(
     except BaseException as err:  # no dlib, no model files: tell the parent, then end
         _reply(results, ("error", None, f"{type(err).__name__}: {err}"))
         return
+    # only now: under SCHED_IDLE, busy processes beside it would starve the models' loading,
+    # which the parent waits for before the episode starts
+    _lower_priority(nice, idle, cpus)
     if not _reply(results, ("ready", None, time.perf_counter() - t0)):
         return
     parent = multiprocessing.parent_process()

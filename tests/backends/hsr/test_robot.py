@@ -8,6 +8,7 @@ through a scenario and prints JSON. pytest's own process never starts a node (co
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import os
@@ -71,7 +72,14 @@ class Output:
         return json.loads(line)
 
     def finish(self, timeout: float = WAIT) -> int:
-        code = self.process.wait(timeout=timeout)
+        try:
+            code = self.process.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            # a hung driver dumps its threads' stacks (faulthandler) into the test's output
+            os.kill(self.process.pid, signal.SIGUSR1)
+            with contextlib.suppress(subprocess.TimeoutExpired):
+                self.process.wait(timeout=2)
+            raise
         self._thread.join(timeout=5)
         return code
 
@@ -226,14 +234,14 @@ def stop_fake(fake: Output) -> None:
     fake.finish()
 
 
-def _driving(ros_master, ros_nodes) -> tuple[Output, Output, Output]:
+def _driving(ros_master, ros_nodes, *driver_args: str) -> tuple[Output, Output, Output]:
     """A fake HSR on sim time, a listener of the base commands, and the driver commanding
     0.1 m/s every period (seen by the listener)."""
     _sim_time(ros_master)
     fake = _fake(ros_nodes, "--sim-time")
     listener = _node(ros_nodes, "twist_listener.py")
     listener.wait(lambda s: s == "READY")
-    driver = _node(ros_nodes, "hsr_driver.py", "drive")
+    driver = _node(ros_nodes, "hsr_driver.py", "drive", *driver_args)
     driver.event("driving")
     listener.wait(lambda s: s.startswith("CMD") and float(s.split()[2]) == 0.1)
     return fake, listener, driver
@@ -305,6 +313,16 @@ def test_ctrl_c_stops_the_base(ros_master, ros_nodes):
     interrupted = time.monotonic()
     os.kill(driver.process.pid, signal.SIGINT)
     assert driver.finish() != 0  # the KeyboardInterrupt ends the process
+    assert _zero_after(listener, interrupted) <= 0.5
+
+
+def test_ctrl_c_inside_a_base_command_stops_the_base(ros_master, ros_nodes):
+    """SIGINT as a base command takes rospy's publish lock: the KeyboardInterrupt still ends the
+    process and the base gets zero (raised inside rospy's publish, it became a RuntimeError of
+    rospy's ``finally`` that the publish error handling swallowed: the driver drove on)."""
+    _, listener, driver = _driving(ros_master, ros_nodes, "--interrupt-at-command", "20")
+    interrupted = driver.event("interrupting")["at"]
+    assert driver.finish() != 0
     assert _zero_after(listener, interrupted) <= 0.5
 
 

@@ -66,6 +66,25 @@ def _wait_gone(pid: int, limit: float = 20.0) -> bool:
 # -- the worker -----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
+@pytest.mark.skipif(not hasattr(os, "SCHED_IDLE"), reason="Linux's SCHED_IDLE")
+def test_an_idle_worker_gets_ready_while_every_cpu_is_busy() -> None:
+    """A busy process on every CPU: the worker still loads its models (it takes SCHED_IDLE only
+    after; before, it starved, and ``pfctl search`` over ROS failed with "face worker: not ready
+    after 60 s")."""
+    spinners = [
+        subprocess.Popen([sys.executable, "-c", "while True: pass"])
+        for _ in range(len(os.sched_getaffinity(0)))
+    ]
+    try:
+        with FaceWorker(FaceParams(), idle=True) as w:
+            assert w.wait_ready(timeout=120.0) > 0
+    finally:
+        for spinner in spinners:
+            spinner.kill()
+            spinner.wait()
+
+
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_an_idle_child_waits_for_a_sleeping_parent_only() -> None:
     """The child starts a job once its parent sleeps: a sleeping process is not running, this

@@ -9,6 +9,7 @@ Scenarios:
   head, odometry, collisions, truth, the step times; then command out of limits, point the head
   out of limits, navigate without a server, close.
 * ``drive``: command 0.1 m/s every period until the robot is lost; report the error.
+  ``--interrupt-at-command N``: SIGINT as the N-th base command takes rospy's publish lock.
 * ``navigate``: a goal to move_base, preempted by a direct command; a second one to the end;
   then a second ``HsrRobot`` in the same process.
 * ``connect``: only connect (``--timeout``), report the error if there is one.
@@ -20,8 +21,11 @@ Scenarios:
 from __future__ import annotations
 
 import argparse
+import faulthandler
 import json
 import math
+import os
+import signal
 import sys
 import time
 from pathlib import Path
@@ -32,6 +36,7 @@ import pfctl
 from pfctl.app.hsr import hsr_config
 from pfctl.app.leg_models import load_leg_model
 from pfctl.backends.hsr.robot import HsrRobot
+from pfctl.backends.hsr.ros_import import import_ros_module
 from pfctl.core.perception.legs.detector import LegDetector
 from pfctl.core.perception.tracking import FieldOfView
 from pfctl.core.robot import STOP, HeadTarget, Pose2D, RobotLostError, Twist2D
@@ -203,14 +208,41 @@ def people(robot: HsrRobot, frames: int) -> None:
     say("people", detector=type(detector).__name__, frames=out)
 
 
+def interrupt_inside_publish(n: int) -> None:
+    """Send this process SIGINT as the ``n``-th base command takes rospy's publish lock: the
+    KeyboardInterrupt then falls inside ``Publisher.publish`` if it runs in the main thread."""
+    topics = import_ros_module("rospy.topics")
+    acquire = topics._PublisherImpl.acquire
+    seen = [0]
+
+    def interrupting(impl: object) -> None:
+        if impl.resolved_name == "/hsrb/command_velocity":
+            seen[0] += 1
+            if seen[0] == n:
+                say("interrupting", at=time.monotonic())
+                os.kill(os.getpid(), signal.SIGINT)
+        acquire(impl)
+
+    topics._PublisherImpl.acquire = interrupting
+
+
 def main() -> None:
+    faulthandler.register(signal.SIGUSR1, all_threads=True)  # a hung driver's stacks
     parser = argparse.ArgumentParser()
     parser.add_argument("scenario", choices=("observe", "drive", "navigate", "connect", "people"))
     parser.add_argument("--timeout", type=float, default=15.0)
     parser.add_argument("--pose", default=None, help="backend.hsr.pose")
     parser.add_argument("--keypoints", default=None, help="backend.hsr.person_keypoints")
     parser.add_argument("--frames", type=int, default=10, help="frames to observe (people)")
+    parser.add_argument(
+        "--interrupt-at-command",
+        type=int,
+        default=0,
+        help="Ctrl-C (SIGINT) as the N-th base command enters rospy's publish lock",
+    )
     args = parser.parse_args(sys.argv[1:])
+    if args.interrupt_at_command:
+        interrupt_inside_publish(args.interrupt_at_command)
     mission = load_mission(HOUSE)
     hsr = HsrConfig(pose=args.pose, person_keypoints=args.keypoints)
     mission = mission.model_copy(update={"backend": BackendConfig(hsr=hsr)})
