@@ -281,6 +281,19 @@ def test_export_bad_input(monkeypatch, capsys, tmp_path) -> None:
     assert list(tmp_path.iterdir()) == []
 
 
+def test_export_refuses_a_resolution_whose_grids_exceed_the_memory_limit(
+    monkeypatch, capsys, tmp_path
+) -> None:
+    """``--resolution 1e-6`` made grids of 10**13 cells (a MemoryError traceback): refused with
+    the mission's grid memory limit before any grid is made."""
+    out = tmp_path / "m.yaml"
+    code, _, err = cli(
+        monkeypatch, capsys, "map", "export", HOUSE, "--resolution", "1e-6", "--out", out
+    )
+    assert_one_error_line(code, err, "--resolution 1e-06", "over the limit of 2 GiB")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_write_regions_creates_a_minimal_mission(tmp_path) -> None:
     target = tmp_path / "new.yaml"
     regions = [Region("r", ((0, 0), (1.23456, 0), (1.23456, 2), (0, 2)))]
