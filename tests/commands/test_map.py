@@ -239,6 +239,8 @@ def test_render_draws_a_mission(monkeypatch, capsys, tmp_path) -> None:
         (["{tmp}/notamap.yaml", "--auto"], ["notamap.yaml", "expected a mission"]),
         (["{map}", "--auto", "--resolution", "0.1"], ["--resolution"]),
         (["{map}", "--regions", "{tmp}/nope.yaml"], ["nope.yaml", "no such file"]),
+        (["{map}", "--auto", "--min-room-area", "nan"], ["'--min-room-area'", "finite", "nan"]),
+        (["{map}", "--auto", "--door-width", "inf"], ["'--door-width'", "finite", "inf"]),
     ],
 )
 def test_bad_input_exits_2_with_one_line_and_writes_nothing(
