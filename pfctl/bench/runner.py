@@ -30,6 +30,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import multiprocessing as mp
+import re
 import signal
 import sys
 import threading
@@ -42,7 +43,16 @@ from pfctl.bench.episode import Episode, error_record, one_blas_thread, run_epis
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.errors import UserError
 
-__all__ = ["RAY_INSTALL", "ray_available", "run_in_processes", "run_on_ray"]
+__all__ = [
+    "RAY_ADDRESS",
+    "RAY_INSTALL",
+    "connect_ray",
+    "disconnect_ray",
+    "ray_address_issue",
+    "ray_available",
+    "run_in_processes",
+    "run_on_ray",
+]
 
 OnRecord = Callable[[dict[str, Any]], None]
 OnRetry = Callable[[EpisodeSpec, str], None]
@@ -230,35 +240,74 @@ def ray_available() -> bool:
     return importlib.util.find_spec("ray") is not None
 
 
+#: What ``--ray`` takes (module docstring), checked before Ray is imported: Ray's own message for
+#: anything else ("Invalid address format") came only after the campaign's files were written.
+RAY_ADDRESS = re.compile(r"auto|local|(ray://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):\d{1,5}")
+
+
+def ray_address_issue(address: str) -> str | None:
+    """What is wrong with ``address`` as a ``--ray`` value, or None if it has the form of one."""
+    if RAY_ADDRESS.fullmatch(address) is None:
+        return "expected auto, local, HOST:PORT or ray://HOST:PORT"
+    return None
+
+
+def connect_ray(address: str, workers: int) -> bool:
+    """Start (``local``, with ``workers`` CPUs) or reach the Ray cluster at ``address``, unless
+    this process is connected already; True when connected here (then :func:`run_on_ray` with
+    ``owned`` shuts Ray down at the end). Done before a campaign writes anything.
+
+    Raises:
+        UserError: Ray is not installed, or the cluster cannot be started or reached.
+    """
+    try:
+        import ray
+    except ImportError:
+        raise UserError(f"--ray {address}: Ray is not installed; {RAY_INSTALL}") from None
+    if ray.is_initialized():
+        return False
+    options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
+    if address == "local":
+        options["num_cpus"] = max(1, workers)
+    try:
+        ray.init(address=address, **options)
+    except (ConnectionError, RuntimeError, ValueError) as err:
+        message = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
+        raise UserError(f"--ray {address}: cannot start or reach Ray: {message}") from None
+    return True
+
+
+def disconnect_ray() -> None:
+    """Shut down the Ray connection :func:`connect_ray` made."""
+    import ray
+
+    ray.shutdown()
+
+
 def run_on_ray(
     specs: Sequence[EpisodeSpec],
     address: str,
     workers: int,
     on_record: OnRecord,
     episode: Episode,
+    *,
+    owned: bool = False,
 ) -> None:
-    """Run ``specs`` as Ray tasks on the cluster at ``address`` (module docstring).
+    """Run ``specs`` as Ray tasks on the cluster at ``address`` (module docstring), connecting
+    first unless connected already; Ray is shut down at the end when connected here or ``owned``
+    (the caller's :func:`connect_ray` connected for this run).
 
     Raises:
         UserError: Ray is not installed, or the cluster cannot be reached.
         KeyboardInterrupt: after the unfinished tasks were cancelled.
     """
-    try:
-        import ray
-    except ImportError:
-        raise UserError(f"--ray {address}: Ray is not installed; {RAY_INSTALL}") from None
     if not specs:
+        if owned:
+            disconnect_ray()
         return
-    started_here = not ray.is_initialized()
-    if started_here:
-        options: dict[str, Any] = {"include_dashboard": False, "log_to_driver": False}
-        if address == "local":
-            options["num_cpus"] = max(1, workers)
-        try:
-            ray.init(address=address, **options)
-        except (ConnectionError, RuntimeError, ValueError) as err:
-            message = str(err).strip().splitlines()[0] if str(err).strip() else type(err).__name__
-            raise UserError(f"--ray {address}: cannot start or reach Ray: {message}") from None
+    started_here = connect_ray(address, workers) or owned
+    import ray
+
     try:
         task = ray.remote(num_cpus=1, max_retries=0)(run_episode_task)
         refs = {task.remote(spec, episode): spec for spec in specs}
@@ -280,4 +329,4 @@ def run_on_ray(
             raise
     finally:
         if started_here:
-            ray.shutdown()
+            disconnect_ray()

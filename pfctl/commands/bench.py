@@ -46,7 +46,15 @@ from pfctl.bench.plan import (
 )
 from pfctl.bench.plan import mission_labels as _labels
 from pfctl.bench.results import RESULTS_FILE, episode_key, latest, open_results
-from pfctl.bench.runner import RAY_INSTALL, ray_available, run_in_processes, run_on_ray
+from pfctl.bench.runner import (
+    RAY_INSTALL,
+    connect_ray,
+    disconnect_ray,
+    ray_address_issue,
+    ray_available,
+    run_in_processes,
+    run_on_ray,
+)
 from pfctl.bench.stop_signals import StopSignals
 from pfctl.bench.variants import parse_vary, variants
 from pfctl.commands import check_seed
@@ -206,17 +214,25 @@ def bench(
             f"--seed {seed} --episodes {episodes}: the last episode's seed "
             f"{seed + episodes - 1} is above {SEED_MAX} (2**32 - 1)"
         )
-    if ray is not None and ray != "local" and not ray.strip():
-        raise UserError("--ray: expected auto, ray://HOST:PORT or local")
+    issue = ray_address_issue(ray) if ray is not None else None
+    if issue is not None:
+        raise UserError(f"--ray {ray}: {issue}")
     if ray is not None and not ray_available():
         raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
     check_output_dir(out, "--out")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
     campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
     console = Console(stderr=True)
-    records, writer = open_results(
-        out, campaign, resume, lambda line: console.print(line, highlight=False, soft_wrap=True)
-    )
+    # Ray is started or reached before anything is written: an unreachable cluster is one line
+    ray_owned = connect_ray(ray, jobs) if ray is not None else False
+    try:
+        records, writer = open_results(
+            out, campaign, resume, lambda line: console.print(line, highlight=False, soft_wrap=True)
+        )
+    except BaseException:
+        if ray_owned:
+            disconnect_ray()
+        raise
     finished = {k for k, r in latest(records).items() if r["status"] == "ok"}
     todo = [s for s in campaign.specs() if s.key not in finished]
     total = len(campaign.specs())
@@ -256,7 +272,7 @@ def bench(
                     )
 
                 if ray is not None:
-                    run_on_ray(todo, ray, jobs, on_record, run_campaign_episode)
+                    run_on_ray(todo, ray, jobs, on_record, run_campaign_episode, owned=ray_owned)
                 else:
                     run_in_processes(todo, jobs, on_record, run_campaign_episode, on_retry)
         except KeyboardInterrupt:

@@ -30,6 +30,7 @@ from pfctl import __version__
 from pfctl.app.leg_data import (
     ScanSequence,
     count_real_scans,
+    real_bags,
     real_sequences,
     sequences_dataset,
     sim_dataset,
@@ -130,6 +131,8 @@ def train_command(
     check_output_file(out, "--out", make_folder=False)
     m = _mission(mission)
     params = leg_params(m)
+    for directory in real or []:  # a wrong folder is refused before the simulation runs
+        real_bags(directory)
     parts = []
     if sim_scans:
         parts.append(_sim(m, sim_scans, seed, params, "simulating scans"))
@@ -261,6 +264,8 @@ def evaluate_command(
         _check_count(history, "--history", 1)
     scans = params.history_scans if history is None else history
     leg_model: LegModel = load_leg_model(model)
+    if real is not None:  # a wrong folder is refused before the simulation runs
+        real_bags(real)
     err = _err()
     test = _sim(m, sim_scans, seed + TEST_SEED_OFFSET, params, "simulating test scans")
     test.name = "sim (held out)"
@@ -269,9 +274,7 @@ def evaluate_command(
     band, everywhere = evaluate_model(leg_model, test, params.probability)
     _row(table, f"sim, seed {seed + TEST_SEED_OFFSET} ({test.scans} scans)", band, everywhere)
     results["sim"] = _figures(band, everywhere)
-    if real is None:
-        err.print("note: no --real DIR given: the real bags are not evaluated")
-    else:
+    if real is not None:
         sequences = dict(_real_sequences(real, params))
         data = sequences_dataset(list(sequences.items()))
         train = _sim(m, sim_scans, seed, params, "simulating training scans")
@@ -302,6 +305,8 @@ def evaluate_command(
             atomic_write(json_out, json.dumps(results, indent=2) + "\n")
         except OSError as e:
             raise UserError(f"--json {json_out}: cannot write: {e.strerror}") from None
+    if real is None:  # after the outputs: an error, if any, is the only line
+        err.print("note: no --real DIR given: the real bags are not evaluated")
 
 
 def _figures(band: Score, everywhere: Score) -> dict[str, float]:

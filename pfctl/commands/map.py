@@ -28,6 +28,7 @@ from rich.console import Console
 from rich.table import Table
 from shapely.geometry import Polygon
 
+from pfctl.commands import check_finite
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import Door, HouseLayout, Region
 from pfctl.core.mapping.rooms import RoomParams, name_after, segment_rooms
@@ -354,10 +355,12 @@ def annotate(
         typer.Option("--reference", help="Mission whose region names --auto rooms take (IoU≥0.5)."),
     ] = None,
     door_width: Annotated[
-        float, typer.Option("--door-width", help="--auto: widest door opening, m.")
+        float,
+        typer.Option("--door-width", callback=check_finite, help="--auto: widest door opening, m."),
     ] = 1.0,
     min_room_area: Annotated[
-        float, typer.Option("--min-room-area", help="--auto: smallest room, m².")
+        float,
+        typer.Option("--min-room-area", callback=check_finite, help="--auto: smallest room, m²."),
     ] = 2.0,
 ) -> None:
     """Propose (--auto) or take regions and doors for a map; write them (--out), draw (--png).

@@ -80,6 +80,11 @@ app.add_typer(experiment_app, name="experiment")
 
 MODEL_NAMES = tuple(MODELS)
 
+#: Most points ``pfctl predict TRACK`` predicts (horizon / step), refused before any array is
+#: made: far beyond any real use (3 s at 0.4 s is 8 points), still well within memory with the
+#: figure and the map (``--horizon 1e9 --step 0.001`` asked for TiB).
+MAX_PREDICTED_POINTS = 1_000_000
+
 
 class OutFormat(str, Enum):
     csv = "csv"
@@ -131,6 +136,20 @@ def _model_list(values: Sequence[str] | None) -> list[str]:
 def _positive(value: float | None, option: str, unit: str = "s") -> None:
     if value is not None and not (math.isfinite(value) and value > 0):
         raise UserError(f"{option}: expected a positive number of {unit}, got {value:g}")
+
+
+def _predicted_points(horizon: float, step: float, track_step: bool) -> int:
+    """How many points ``horizon`` seconds ``step`` apart are (at least one), refused over
+    :data:`MAX_PREDICTED_POINTS` before any array is made (``track_step``: the step is the
+    track's, not ``--step``)."""
+    points = horizon / step
+    if not points <= MAX_PREDICTED_POINTS:
+        at = f"the track's step of {step:g} s" if track_step else f"--step {step:g}"
+        raise UserError(
+            f"--horizon {horizon:g}: {points:.3g} predicted points at {at}, over the limit of "
+            f"{MAX_PREDICTED_POINTS:,}; use a shorter --horizon or a longer --step"
+        )
+    return max(1, math.ceil(points - 1e-9))
 
 
 def _mission_params(mission: Mission | None, name: str) -> dict[str, Any]:
@@ -278,7 +297,7 @@ def track(
     full = read_csv_trajectory(track_file, min_points=2)
     history = full.last(history_s)
     dt = step or float(np.median(np.diff(full.t)))
-    n = max(1, math.ceil(horizon / dt - 1e-9))
+    n = _predicted_points(horizon, dt, step is None)
     times = full.t[-1] + np.minimum(np.arange(1, n + 1) * dt, horizon)
     xy = _fit_predict(name, history, times, params, str(track_file))
     used = {k: v for k, v in vars(make_model(name, **params)).items() if not k.endswith("_")}

@@ -78,14 +78,17 @@ def _bad_profiles(tmp_path: Path) -> dict[str, tuple[Path, str]]:
     noise.write_bytes(np.random.default_rng(0).bytes(5000))
     pickled = tmp_path / "pickled.npz"
     np.savez(pickled, **{**_fields(_profile()), "faces": np.array([{"evil": 1}], dtype=object)})
+    empty = tmp_path / "empty.npz"  # numpy's EOFError was click's "Aborted!", exit 1
+    empty.write_bytes(b"")
     return {
+        "empty": (empty, "not a target profile: not an .npz archive"),
         "truncated": (truncated, "damaged target profile (.npz): truncated or corrupt archive"),
         "noise": (noise, "not a target profile: not an .npz archive"),
         "pickled": (pickled, "not a target profile: an array holds pickled Python objects"),
     }
 
 
-@pytest.mark.parametrize("kind", ["truncated", "noise", "pickled"])
+@pytest.mark.parametrize("kind", ["truncated", "noise", "pickled", "empty"])
 @pytest.mark.parametrize(
     "command",
     [

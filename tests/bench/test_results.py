@@ -269,6 +269,42 @@ def test_ray_missing_is_one_line_and_writes_nothing(
     assert not out.exists()
 
 
+@pytest.mark.parametrize("address", ["carrier-pigeon", "ray://", "host:port", ""])
+def test_a_malformed_ray_address_is_one_line_and_writes_nothing(
+    address: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """``--ray carrier-pigeon`` printed the plan line, wrote campaign.json and only then heard
+    Ray's "Invalid address format": now refused before Ray is imported or anything written."""
+    monkeypatch.setattr(bench_command, "connect_ray", lambda *_: pytest.fail("Ray was started"))
+    out = tmp_path / "c"
+    code, stdout, err = bench(out, [*BASE_ARGS, "--ray", address], capsys, monkeypatch)
+    assert code == 2 and stdout == ""
+    assert err == (
+        f"pfctl: error: --ray {address}: expected auto, local, HOST:PORT or ray://HOST:PORT\n"
+    )
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_ray_cluster_out_of_reach_is_one_line_and_writes_nothing(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ray is reached before the campaign's files are written."""
+
+    def unreachable(address: str, workers: int) -> bool:
+        raise UserError(f"--ray {address}: cannot start or reach Ray: timed out")
+
+    monkeypatch.setattr(bench_command, "ray_available", lambda: True)
+    monkeypatch.setattr(bench_command, "connect_ray", unreachable)
+    out = tmp_path / "c"
+    code, stdout, err = bench(out, [*BASE_ARGS, "--ray", "ray://head:10001"], capsys, monkeypatch)
+    assert code == 2 and stdout == ""
+    assert err == "pfctl: error: --ray ray://head:10001: cannot start or reach Ray: timed out\n"
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_a_bad_results_line_is_named(tmp_path: Path) -> None:
     path = tmp_path / RESULTS_FILE
     path.write_text('{"mission_file": "m.yaml", "variant": "base", "seed": 1}\nnot json\n')

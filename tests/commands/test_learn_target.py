@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import hashlib
 import math
+import subprocess
+import sys
 from pathlib import Path
 
 import cv2
@@ -185,3 +187,26 @@ def test_seeing_no_person_fails_and_writes_nothing(tmp_path, capsys, monkeypatch
     code, _, stderr = run_cli(args, capsys, monkeypatch)
     assert code == 2 and "saw no person" in stderr and stderr.count("\n") == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == ["blind.yaml"]
+
+
+def test_an_image_smaller_than_the_people_detector_window_is_refused_cleanly(
+    tmp_path: Path,
+) -> None:
+    """A 64 × 48 grey picture is smaller than the HOG detector's 64 × 128 window, which made
+    OpenCV crash the process (SIGSEGV): the detector is not run on it, so nobody is seen. A real
+    process, so that a crash fails this test instead of ending pytest."""
+    cv2.imwrite(str(tmp_path / "i.png"), np.full((48, 64), 128, np.uint8))
+    args = ["learn-target", str(HOUSE), "--from", "i.png", "--out", "t.npz"]
+    done = subprocess.run(
+        [sys.executable, "-m", "pfctl", *args],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        check=False,
+        timeout=300,
+    )
+    assert done.returncode == 2, done.stderr
+    assert (
+        done.stderr == "pfctl: error: --from i.png: saw no person in 1 frame(s); nothing written\n"
+    )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["i.png"]

@@ -2,12 +2,15 @@
 
 from __future__ import annotations
 
+import errno
+import os
 from pathlib import Path
 
 import pytest
 
 from pfctl.app.leg_data import real_dataset
 from pfctl.app.leg_models import read_leg_model
+from pfctl.commands import legs as legs_command
 from pfctl.core.perception.legs.detector import LegParams
 from pfctl.core.perception.legs.features import FEATURE_NAMES
 from pfctl.core.perception.legs.training import evaluate_model
@@ -71,6 +74,45 @@ def test_corrupt_model_exits_2(
     bad.write_text("hello")
     code, _, stderr = run_cli(["legs", "evaluate", "--model", str(bad)], capsys, monkeypatch)
     assert code == 2 and "bad.npz: not a leg model" in stderr
+
+
+@pytest.mark.parametrize("command", ["train", "evaluate"])
+def test_a_wrong_real_folder_is_refused_before_the_simulation(
+    command: str,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    monkeypatch.setattr(legs_command, "_sim", lambda *_: pytest.fail("simulated first"))
+    (tmp_path / "d").mkdir()
+    args = ["legs", command, "--sim-scans", "20", "--real", str(tmp_path / "d")]
+    if command == "train":
+        args += ["--out", str(tmp_path / "m.npz")]
+    code, stdout, stderr = run_cli(args, capsys, monkeypatch)
+    assert code == 2 and stdout == ""
+    assert (
+        stderr.startswith(f"pfctl: error: {tmp_path / 'd'}: no leg bags")
+        and stderr.count("\n") == 1
+    )
+    assert [p.name for p in tmp_path.iterdir()] == ["d"]
+
+
+def test_an_error_after_the_evaluation_is_the_only_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The note that no --real was given came before a late error (the --json write)."""
+
+    def disk_full(path: Path, data: str) -> None:
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr("pfctl.files.atomic_write", disk_full)
+    out = tmp_path / "l.json"
+    code, _, stderr = run_cli(
+        ["legs", "evaluate", "--sim-scans", "20", "--json", str(out)], capsys, monkeypatch
+    )
+    assert code == 2
+    assert stderr == f"pfctl: error: --json {out}: cannot write: No space left on device\n"
+    assert not out.exists()
 
 
 @pytest.mark.skipif(not LEGS.is_dir(), reason=f"no real leg bags in {LEGS}")

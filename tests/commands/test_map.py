@@ -239,6 +239,8 @@ def test_render_draws_a_mission(monkeypatch, capsys, tmp_path) -> None:
         (["{tmp}/notamap.yaml", "--auto"], ["notamap.yaml", "expected a mission"]),
         (["{map}", "--auto", "--resolution", "0.1"], ["--resolution"]),
         (["{map}", "--regions", "{tmp}/nope.yaml"], ["nope.yaml", "no such file"]),
+        (["{map}", "--auto", "--min-room-area", "nan"], ["'--min-room-area'", "finite", "nan"]),
+        (["{map}", "--auto", "--door-width", "inf"], ["'--door-width'", "finite", "inf"]),
     ],
 )
 def test_bad_input_exits_2_with_one_line_and_writes_nothing(
@@ -278,6 +280,19 @@ def test_export_bad_input(monkeypatch, capsys, tmp_path) -> None:
     assert_one_error_line(code, err, "x.yaml")
     code, _, err = cli(monkeypatch, capsys, "map", "export", HOUSE, "--out", tmp_path / "m.png")
     assert_one_error_line(code, err, "--out", ".yaml")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_export_refuses_a_resolution_whose_grids_exceed_the_memory_limit(
+    monkeypatch, capsys, tmp_path
+) -> None:
+    """``--resolution 1e-6`` made grids of 10**13 cells (a MemoryError traceback): refused with
+    the mission's grid memory limit before any grid is made."""
+    out = tmp_path / "m.yaml"
+    code, _, err = cli(
+        monkeypatch, capsys, "map", "export", HOUSE, "--resolution", "1e-6", "--out", out
+    )
+    assert_one_error_line(code, err, "--resolution 1e-06", "over the limit of 2 GiB")
     assert list(tmp_path.iterdir()) == []
 
 

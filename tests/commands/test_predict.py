@@ -186,6 +186,32 @@ def test_bad_options_exit_2(
     assert_one_error_line(err, "--horizon")
 
 
+@pytest.mark.parametrize(
+    ("options", "words"),
+    [
+        (["--horizon", "1e9", "--step", "0.001"], "1e+12 predicted points at --step 0.001"),
+        (["--horizon", "1e9"], "1e+10 predicted points at the track's step of 0.1 s"),
+        (["--horizon", "1e300", "--step", "1e-300"], "inf predicted points at --step 1e-300"),
+    ],
+)
+def test_a_horizon_of_too_many_points_is_refused_before_any_work(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    options: list[str],
+    words: str,
+) -> None:
+    """``--horizon 1e9 --step 0.001`` asked for a trillion points (a MemoryError traceback):
+    refused up front, naming the option and the limit, nothing written."""
+    track = _track_csv(tmp_path / "walk.csv", (0.0, 0.0), (1.0, 0.0))
+    out, plot = tmp_path / "p.csv", tmp_path / "p.png"
+    args = ["predict", str(track), *options, "--out", str(out), "--plot", str(plot)]
+    code, stdout, err = run_cli(args, capsys, monkeypatch)
+    assert code == 2 and stdout == ""
+    assert_one_error_line(err, "--horizon", words, "over the limit of 1,000,000")
+    assert [p.name for p in tmp_path.iterdir()] == ["walk.csv"]
+
+
 @pytest.mark.slow
 def test_real_process_contract(tmp_path: Path) -> None:
     """The console script for real: exit 2 and one line, no traceback."""

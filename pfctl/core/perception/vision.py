@@ -398,13 +398,25 @@ class HogPersonDetector:
         self.central_fraction = central_fraction
         self.min_score = min_score
 
+    def fits(self, shape: tuple[int, ...]) -> bool:
+        """Whether an image of this shape (rows, columns, ...) holds the detector's window.
+
+        Nobody smaller than the window can be found (the search only scales the image down), and
+        OpenCV's ``detectMultiScale`` may crash the process (SIGSEGV) on a smaller image.
+        """
+        win_w, win_h = self._hog.winSize
+        return shape[0] >= win_h and shape[1] >= win_w
+
     def boxes(self, rgb: np.ndarray) -> list[tuple[Box, float]]:
-        """Person boxes in an RGB image with their SVM scores, after suppression, best first."""
+        """Person boxes in an RGB image with their SVM scores, after suppression, best first
+        (none in an image smaller than the detector's window, see :meth:`fits`)."""
         import cv2
 
         img = rgb
         if self.upscale != 1.0:
             img = cv2.resize(rgb, None, fx=self.upscale, fy=self.upscale)
+        if not self.fits(img.shape):
+            return []
         rects, weights = self._hog.detectMultiScale(
             np.ascontiguousarray(img),
             hitThreshold=self.hit_threshold,
