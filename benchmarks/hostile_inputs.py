@@ -124,9 +124,14 @@ def child_env(force_terminal: bool) -> dict[str, str]:
 
 
 def _limit(memory_mb: int) -> Callable[[], None]:
+    """In the child before exec: the memory limit, and Ctrl-C as a terminal gives it (a script
+    started in the background, ``nohup … &``, hands its children SIGINT ignored, which pfctl
+    rightly keeps ignored: the interruption cases would then measure the shell, not pfctl)."""
+
     def apply() -> None:
         limit = memory_mb * 1024 * 1024
         resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+        signal.signal(signal.SIGINT, signal.SIG_DFL)
 
     return apply
 
@@ -436,7 +441,7 @@ def judge(
                 missing = [n for n in case.expect.names if not names(lines[0], n, case.argv)]
                 if missing:
                     problems.append(f"does not name {', '.join(missing)}")
-                said = [w for w in case.expect.avoid if w in lines[0]]
+                said = [w for w in case.expect.avoid if w.lower() in lines[0].lower()]
                 if said:
                     problems.append(f"says {', '.join(said)}")
             after = snapshot(ws)

@@ -8,9 +8,9 @@ import sys
 import typer
 
 try:  # typer 0.2x carries its own copy of click
-    from typer._click.exceptions import ClickException, NoArgsIsHelpError
+    from typer._click.exceptions import ClickException, MissingParameter, NoArgsIsHelpError
 except ImportError:  # pragma: no cover - older typer uses click itself
-    from click.exceptions import ClickException, NoArgsIsHelpError
+    from click.exceptions import ClickException, MissingParameter, NoArgsIsHelpError
 
 from pfctl import __version__
 from pfctl.commands import bench as bench_command
@@ -84,6 +84,10 @@ def _run_app() -> None:
 
 def _usage_line(err: ClickException) -> str:
     message = " ".join(err.format_message().split()).rstrip(".")
+    param = getattr(err, "param", None)
+    is_argument = param is not None and param.param_type_name == "argument" and param.name
+    if isinstance(err, MissingParameter) and is_argument:  # as the usage line has it: MISSION
+        message = f"Missing argument {param.name.upper()}"
     ctx = getattr(err, "ctx", None)
     names: list[str] = []
     while ctx is not None and ctx.parent is not None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import signal
 import sys
 from pathlib import Path
 
@@ -14,6 +15,14 @@ from pfctl.core.mapping.walls import rasterize_house
 from pfctl.mission import Mission, load_mission
 
 HOUSE_MISSION = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Ctrl-C as in a terminal for the commands the tests start and interrupt: a run started in
+    the background (``nohup … &``, some CI runners) inherits SIGINT ignored, passes it on to its
+    children, and pfctl rightly keeps a signal it was started ignoring ignored."""
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(scope="session")

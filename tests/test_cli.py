@@ -29,7 +29,7 @@ def _assert_one_usage_line(err: str, *fragments: str) -> None:
     [
         (["predict", "evaluate", "data", "--jobs", "0"], ["predict evaluate: ", "'--jobs'", "1"]),
         (["follow", "missions/house.yaml", "--bogus"], ["follow: ", "No such option: --bogus"]),
-        (["follow"], ["follow: ", "Missing argument 'mission'"]),
+        (["follow"], ["follow: ", "Missing argument MISSION"]),
         (["follow", "missions/house.yaml", "--seed", "abc"], ["follow: ", "'--seed'"]),
         (["mission", "nosuch"], ["mission: ", "No such command 'nosuch'"]),
         (["nosuch"], ["No such command 'nosuch'", "see pfctl --help"]),
