@@ -93,6 +93,20 @@ def save_map_server(
     return yaml_file, pgm_file
 
 
+def _map_yaml(path: Path) -> tuple[dict[str, Any], Path, float]:
+    """A map_server YAML's fields, its image's path (relative to the YAML) and its resolution,
+    checked (> 0)."""
+    meta = _read_yaml(path)
+    image_name = _field(meta, "image", path, str)
+    resolution = _number(meta, "resolution", path)
+    if not resolution > 0:
+        raise GridFileError(f"{path}: resolution must be > 0, got {resolution}")
+    image_path = Path(image_name)
+    if not image_path.is_absolute():
+        image_path = path.parent / image_path
+    return meta, image_path, resolution
+
+
 def load_map_server(
     yaml_path: str | os.PathLike[str], sensor_model: InverseSensorModel | None = None
 ) -> OccupancyGrid:
@@ -115,11 +129,7 @@ def load_map_server(
     Anything wrong with either file raises :class:`GridFileError` naming the file.
     """
     path = Path(yaml_path)
-    meta = _read_yaml(path)
-    image_name = _field(meta, "image", path, str)
-    resolution = _number(meta, "resolution", path)
-    if not resolution > 0:
-        raise GridFileError(f"{path}: resolution must be > 0, got {resolution}")
+    meta, image_path, resolution = _map_yaml(path)
     origin = meta.get("origin")
     if origin is None:
         raise GridFileError(f"{path}: missing required key 'origin'")
@@ -144,9 +154,6 @@ def load_map_server(
     if mode not in _MAP_MODES:
         raise GridFileError(f"{path}: mode must be one of {', '.join(_MAP_MODES)}, got {mode!r}")
 
-    image_path = Path(image_name)
-    if not image_path.is_absolute():
-        image_path = path.parent / image_path
     color = read_pgm(image_path)  # float 0..255, first row = top
     if negate:
         color = 255.0 - color
@@ -247,14 +254,7 @@ def map_server_size(yaml_path: str | os.PathLike[str]) -> tuple[int, int, float]
     :class:`GridFileError` naming the file, so a mission can refuse an unreadable or oversized
     map before anything loads it."""
     path = Path(yaml_path)
-    meta = _read_yaml(path)
-    image_name = _field(meta, "image", path, str)
-    resolution = _number(meta, "resolution", path)
-    if not resolution > 0:
-        raise GridFileError(f"{path}: resolution must be > 0, got {resolution}")
-    image_path = Path(image_name)
-    if not image_path.is_absolute():
-        image_path = path.parent / image_path
+    _, image_path, resolution = _map_yaml(path)
     try:
         with image_path.open("rb") as handle:
             head = handle.read(_HEADER_BYTES)
