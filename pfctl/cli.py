@@ -102,7 +102,7 @@ def _usage_line(err: ClickException) -> str:
 def main() -> None:
     """Console entry point: user errors become one line on stderr and exit status 2; SIGINT and
     SIGTERM (:mod:`pfctl.interrupts`) one line and exit status 130 or 143."""
-    with command_signals():
+    with command_signals(ending=True):
         try:
             _run_app()
         except UserError as err:

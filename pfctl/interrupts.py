@@ -8,16 +8,16 @@ signal's number, as a shell reports a process it killed).
 
 From the moment a run opens :func:`graceful_interrupts` until the command ends, signals no longer
 raise: the first sets the run's :class:`StopFlag` (the loop ends at its next tick, stops the base,
-and the command writes what was measured); the second, at any spacing, is acknowledged on stderr
-and changes nothing; only a third abandons the writing (raises :class:`Interrupted`; the base is
-still stopped by the context managers). The command ends with :meth:`StopFlag.exit_if_set`: one
-line saying what was written and the exit status of the first signal.
+and the command writes what was measured); the second, at any spacing, changes nothing (the
+command still ends with its one line); only a third abandons the writing (raises
+:class:`Interrupted`; the base is still stopped by the context managers). The command ends with
+:meth:`StopFlag.exit_if_set`: one line saying what was written and the exit status of the first
+signal.
 """
 
 from __future__ import annotations
 
 import contextlib
-import os
 import signal
 import sys
 import threading
@@ -105,16 +105,7 @@ class _Signals:
             flag.signum = signum
             flag.set = True
         elif len(self.received) < ABANDON_AFTER:
-            line = (
-                f"{signal_name(signum)}: still stopping and writing what was measured "
-                "(a third signal abandons the writing)\n"
-            )
-            # straight to the descriptor: the handler may run inside a write to sys.stderr,
-            # whose buffer refuses a reentrant call
-            try:
-                os.write(sys.stderr.fileno(), line.encode())
-            except (OSError, ValueError):  # no descriptor (captured): as usual
-                sys.stderr.write(line)
+            pass  # already stopping: the run ends and its outputs are written all the same
         else:
             self.raise_now(self.received[0], "three times: abandoned writing the outputs")
 
@@ -142,9 +133,12 @@ def _restore(previous: dict[int, object]) -> None:
 
 
 @contextlib.contextmanager
-def command_signals() -> Iterator[_Signals]:
+def command_signals(*, ending: bool = False) -> Iterator[_Signals]:
     """While open (the whole command), SIGINT and SIGTERM are handled as the module docstring
-    says; SIGTERM never kills the process without running its ``finally`` blocks."""
+    says; SIGTERM never kills the process without running its ``finally`` blocks. ``ending``:
+    the process ends with the command, so after a signal the two stay ignored rather than
+    restored (a later one could only turn the exit status already reported into a death by
+    that signal)."""
     global _state
     _state = _Signals()
     if threading.current_thread() is not threading.main_thread():
@@ -155,7 +149,11 @@ def command_signals() -> Iterator[_Signals]:
     try:
         yield _state
     finally:
-        _restore(previous)
+        if ending and _state.received:
+            for signum in HANDLED:
+                signal.signal(signum, signal.SIG_IGN)
+        else:
+            _restore(previous)
         _state.installed = False
 
 

@@ -119,8 +119,7 @@ def _check_ending(code: int, err: str, signals: tuple[int, ...], wrote: str) -> 
     assert len(lines) == 1, err
     assert lines[0].startswith(f"pfctl: interrupted ({first.name}) after "), lines
     assert lines[0].endswith(f"wrote {wrote}"), lines
-    if len(signals) > 1:  # the second is acknowledged, and changes nothing
-        assert f"{signal.Signals(signals[1]).name}: still stopping" in err, err
+    assert "still stopping" not in err  # a second signal changes nothing, says nothing
 
 
 @pytest.fixture(scope="module")
