@@ -20,6 +20,7 @@ import pytest
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.core.perception.face_worker import FaceWorker
 from tests.conftest import HOUSE_MISSION
+from tests.processes import process_gone
 
 pytestmark = [pytest.mark.slow]
 
@@ -128,15 +129,6 @@ def _records(out: Path) -> list[dict[str, Any]]:
     return [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
 
 
-def _gone(pid: int) -> bool:
-    """Whether process ``pid`` has ended (gone, or a zombie nobody reaped yet)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
-    except FileNotFoundError:
-        return True
-
-
 def test_a_killed_worker_s_episode_runs_again_on_a_new_one(tmp_path: Path) -> None:
     out = tmp_path / "c"
     code, err = _finish(_bench("dies_once", out, "--episodes", "2", "--workers", "2"))
@@ -211,7 +203,7 @@ def test_signals_keep_what_finished_and_leave_no_process(
     assert "Traceback" not in err and "Error" not in err
     assert [r["seed"] for r in _records(out)] == [1]
     assert "1/3 episodes" in (out / "summary.md").read_text()
-    assert all(_gone(pid) for pid in pids), pids
+    assert all(process_gone(pid) for pid in pids), pids
 
 
 def test_ctrl_c_while_workers_start_prints_no_traceback(tmp_path: Path) -> None:

@@ -28,6 +28,7 @@ from pfctl.core.perception.identity.profile import (
     learn_profile,
 )
 from pfctl.core.perception.vision import PersonDetection
+from tests.processes import process_gone
 
 ROOT = Path(__file__).resolve().parents[3]
 RED, NAVY, GREY = (200, 30, 40), (40, 40, 120), (90, 90, 90)
@@ -45,19 +46,10 @@ def worker() -> Iterator[FaceWorker]:
         yield w
 
 
-def _gone(pid: int) -> bool:
-    """Whether process ``pid`` has ended (gone, or a zombie nobody reaped yet)."""
-    try:
-        with open(f"/proc/{pid}/stat") as f:
-            return f.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
-    except FileNotFoundError:
-        return True
-
-
 def _wait_gone(pid: int, limit: float = 20.0) -> bool:
     deadline = time.monotonic() + limit
     while time.monotonic() < deadline:
-        if _gone(pid):
+        if process_gone(pid):
             return True
         time.sleep(0.05)
     return False
@@ -155,7 +147,7 @@ def test_close_stops_the_child_and_the_worker_says_so_after() -> None:
     # longer than close's default wait, after which it would be terminated (exit code -15)
     w.close(timeout=60.0)
     assert w.closed and w._process.exitcode == 0
-    assert pid is not None and _gone(pid)
+    assert pid is not None and process_gone(pid)
     w.close()  # twice is fine
     with pytest.raises(FaceWorkerError, match="after close"):
         w.poll()
