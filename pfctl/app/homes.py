@@ -9,11 +9,17 @@ is returned, so no invalid home is ever written; a home the options cannot give 
 
 from __future__ import annotations
 
+import itertools
 import os
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
+import shapely
+
 from pfctl.core.homes import Home, HomeOptions, ImpossibleHomeError, generate_home
+from pfctl.core.homes.reach import home_planner
+from pfctl.core.mapping.planning import NoPathError
 from pfctl.errors import MissionError, UserError
 from pfctl.files import write_output
 from pfctl.mission import Mission, load_mission, loads_mission
@@ -25,6 +31,7 @@ __all__ = [
     "command_line",
     "home_file_name",
     "make_home",
+    "planned_walks",
     "write_homes",
 ]
 
@@ -119,3 +126,34 @@ def write_homes(
             write_output(path, made.text)
         paths.append(path)
     return paths
+
+
+def planned_walks(mission: Mission) -> list[tuple[str, np.ndarray, bool]]:
+    """Each person's route as the simulator's walkers plan it (a person's radius on the static
+    map, through doors): ``(name, (n, 2) points, is_target)``. A region stop is the free point
+    nearest its centre (in an episode the seed picks a random one); a route that cannot be
+    planned is left out."""
+    from pfctl.backends.pybullet.walkers import PERSON_RADIUS
+
+    layout = mission.layout()
+    planner = home_planner(
+        layout, mission.map.resolution, mission.map.wall_thickness, PERSON_RADIUS
+    )
+    walks = []
+    for person in mission.scenario.people:
+        stops = []
+        for stop in person.route:
+            if isinstance(stop, str):
+                centre = shapely.Polygon(layout.region(stop).polygon).centroid
+                stop = planner.nearest_free((centre.x, centre.y), max_distance=5.0)
+                if stop is None:
+                    break
+            stops.append(np.asarray(stop, dtype=float))
+        else:
+            try:
+                legs = [planner.plan(a, b) for a, b in itertools.pairwise(stops)]
+            except NoPathError:
+                continue
+            path = np.vstack(legs) if legs else np.asarray(stops)
+            walks.append((person.name, path, person.name == mission.scenario.target))
+    return walks

@@ -298,10 +298,16 @@ def _prepare_parent(path: Path, option: str) -> None:
         raise UserError(f"{option} {path}: cannot create its folder: {err.strerror}") from None
 
 
-def _png_bytes(grid: OccupancyGrid, layout: HouseLayout | None, graph: bool, title: str) -> bytes:
+def _png_bytes(
+    grid: OccupancyGrid,
+    layout: HouseLayout | None,
+    graph: bool,
+    title: str,
+    routes: list[tuple[str, Any, bool]] | None = None,
+) -> bytes:
     from pfctl.plots.map import map_figure
 
-    fig = map_figure(grid, layout, region_graph=graph, title=title)
+    fig = map_figure(grid, layout, region_graph=graph, title=title, routes=routes or ())
     buf = io.BytesIO()
     fig.savefig(buf, format="png", bbox_inches="tight")
     return buf.getvalue()
@@ -470,6 +476,12 @@ def render(
     graph: Annotated[
         bool, typer.Option("--graph/--no-graph", help="Draw the region graph.")
     ] = True,
+    routes: Annotated[
+        bool,
+        typer.Option(
+            "--routes", help="Draw the scenario's people walking their routes (as planned)."
+        ),
+    ] = False,
 ) -> None:
     """Draw a mission's map with its regions, doors and region graph to a PNG."""
     if resolution is not None and not (math.isfinite(resolution) and resolution > 0):
@@ -479,7 +491,12 @@ def render(
     _prepare_parent(png, "--png")
     layout = src.layout
     title = src.mission.name if src.mission is not None else mission.name
-    write_output(png, _png_bytes(src.grid, layout, graph, title))
+    walks = None
+    if routes and src.mission is not None:
+        from pfctl.app.homes import planned_walks
+
+        walks = planned_walks(src.mission)
+    write_output(png, _png_bytes(src.grid, layout, graph, title, walks))
     console = _console()
     if layout is not None:
         console.print(summary_table(layout, title=f"{mission}: {len(layout.regions)} regions"))

@@ -28,6 +28,8 @@ from pfctl.core.mapping.house import HouseLayout
 from pfctl.files import write_output
 
 XY = tuple[float, float]
+Route = tuple[str, Sequence[XY], bool]
+"""A person's walk: name, points, whether they are the target."""
 
 #: Cell colours: free white, occupied black, unknown grey.
 FREE_RGB = (1.0, 1.0, 1.0)
@@ -71,13 +73,41 @@ def grid_rgb(states: np.ndarray) -> np.ndarray:
     return rgb
 
 
+ROUTE_COLOR = "#6a6a6a"
+TARGET_COLOR = "#d62728"
+
+
+def _draw_routes(ax: object, routes: Sequence[Route], handles: list[object]) -> None:
+    """Each person's walk: a dashed line from a square (the start) to a circle (the end); the
+    target's red and thicker, the others grey, each named at its start."""
+    for name, path, is_target in routes:
+        xy = np.asarray(path, dtype=float).reshape(-1, 2)
+        color = TARGET_COLOR if is_target else ROUTE_COLOR
+        ax.plot(  # type: ignore[attr-defined]
+            xy[:, 0], xy[:, 1], color=color, linewidth=2.0 if is_target else 1.2,
+            linestyle="--", zorder=7,
+        )  # fmt: skip
+        ax.scatter(xy[:1, 0], xy[:1, 1], marker="s", s=40, color=color, zorder=8)  # type: ignore[attr-defined]
+        ax.scatter(xy[-1:, 0], xy[-1:, 1], marker="o", s=30, color=color, zorder=8)  # type: ignore[attr-defined]
+        ax.annotate(  # type: ignore[attr-defined]
+            name, (xy[0, 0], xy[0, 1]), xytext=(4, -10), textcoords="offset points",
+            fontsize=8, color=color, zorder=8,
+        )  # fmt: skip
+    if any(is_target for _, _, is_target in routes):
+        handles.append(Line2D([], [], color=TARGET_COLOR, linestyle="--", label="target's walk"))
+    if any(not is_target for _, _, is_target in routes):
+        handles.append(Line2D([], [], color=ROUTE_COLOR, linestyle="--", label="other people"))
+
+
 def map_figure(
     grid: object,
     layout: HouseLayout | None = None,
     region_graph: bool = True,
     title: str | None = None,
+    routes: Sequence[Route] = (),
 ) -> Figure:
-    """The map figure (see :func:`plot_map`) as a matplotlib Figure, not yet written."""
+    """The map figure (see :func:`plot_map`) as a matplotlib Figure, not yet written; ``routes``:
+    people's walks ``(name, (n, 2) points, is_target)`` drawn over it."""
     geometry = grid.geometry  # type: ignore[attr-defined]
     states = grid.states()  # type: ignore[attr-defined]
     xmin, xmax, ymin, ymax = geometry.extent
@@ -144,6 +174,7 @@ def map_figure(
                 zorder=6,
                 bbox={"boxstyle": "round,pad=0.2", "fc": "white", "ec": "none", "alpha": 0.8},
             )
+    _draw_routes(ax, routes, handles)
     handles.append(Patch(facecolor=OCCUPIED_RGB, label="occupied"))
     handles.append(Patch(facecolor=UNKNOWN_RGB, label="unknown"))
     ax.legend(handles=handles, loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize=8)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import shapely
 
-from pfctl.app.homes import make_home, write_homes
+from pfctl.app.homes import make_home, planned_walks, write_homes
 from pfctl.backends.pybullet.walkers import PERSON_RADIUS
 from pfctl.core.homes import LAYOUTS, HomeOptions
 from pfctl.core.homes.plans import CIRCULATION, DOOR_WIDTH, MIN_ROOM, OPENING_WIDTH
@@ -99,6 +99,18 @@ def test_the_target_walks_through_at_least_two_doors(
     route = [np.asarray(p, dtype=float) for p in mission.scenario.people[0].route]
     walk = np.vstack([person.plan(a, b) for a, b in itertools.pairwise(route)])
     assert len(doors_crossed(walk, layout.doors)) >= 2
+
+
+def test_the_walks_drawn_are_the_walks_planned(
+    generated: tuple[HomeOptions, str, Mission],
+) -> None:
+    """``map render --routes``: one walk per person, the target's first, through >= 2 doors."""
+    _, _, mission = generated
+    walks = planned_walks(mission)
+    assert [name for name, _, _ in walks] == [p.name for p in mission.scenario.people]
+    _, path, is_target = walks[0]
+    assert is_target and not any(t for _, _, t in walks[1:])
+    assert len(doors_crossed(path, mission.layout().doors)) >= 2
 
 
 def test_furniture_blocks_no_door(generated: tuple[HomeOptions, str, Mission]) -> None:

@@ -216,6 +216,17 @@ def test_render_draws_a_mission(monkeypatch, capsys, tmp_path) -> None:
     assert width > 400 and height > 300
 
 
+def test_render_draws_the_people_walking_their_routes(monkeypatch, capsys, tmp_path) -> None:
+    """``--routes``: the scenario's walks as planned, e.g. on a generated home (issue 22)."""
+    png, plain = tmp_path / "routes.png", tmp_path / "plain.png"
+    code, _, err = cli(monkeypatch, capsys, "map", "render", HOUSE, "--routes", "--png", png)
+    assert code == 0, err
+    code, _, err = cli(monkeypatch, capsys, "map", "render", HOUSE, "--png", plain)
+    assert code == 0, err
+    assert png.read_bytes() != plain.read_bytes()
+    assert png_size(png)[0] > png_size(plain)[0] * 0.9
+
+
 @pytest.mark.parametrize(
     ("args", "words"),
     [
