@@ -92,15 +92,21 @@ class FloorPlan:
         return tuple(r for r in self.regions if r.name not in CIRCULATION)
 
     def describe(self) -> str:
-        """``corridor layout, 14.2 × 10.3 m: 6 rooms (kitchen, ...) off a corridor, 7 doors``."""
+        """The kind, size, rooms and doors in one line: ``corridor layout, 14.2 x 10.3 m: 6 rooms
+        (living_room, ...) and a corridor; 6 doors, 1 wide opening``."""
         wide = sum(1 for d in self.doors if _length(d) > DOOR_WIDTH[1] + 1e-6)
         names = ", ".join(r.name for r in self.rooms)
         others = [r.name for r in self.regions if r.name in CIRCULATION]
         via = f" and a {others[0]}" if others else ""
         return (
             f"{self.kind} layout, {self.width:g} x {self.height:g} m: {len(self.rooms)} rooms "
-            f"({names}){via}; {len(self.doors) - wide} doors, {wide} wide openings"
+            f"({names}){via}; {_count(len(self.doors) - wide, 'door')}, "
+            f"{_count(wide, 'wide opening')}"
         )
+
+
+def _count(n: int, noun: str) -> str:
+    return f"{n} {noun}" if n == 1 else f"{n} {noun}s"
 
 
 def _length(door: Door) -> float:
