@@ -643,6 +643,14 @@ def _mission_cases() -> list[Case]:
         ),
         _err("ms-out-is-dir", "mission schema", ["--out", "d"], ["--out"], {"d/keep": "x"}),
         _err(
+            "mg-impossible-home",
+            "mission generate",
+            ["--rooms", "40", "--size", "5x5", "--out", "o/home.yaml"],
+            ["--rooms"],
+        ),
+        _err("mg-bad-size", "mission generate", ["--size", "5by5", "--out", "h.yaml"], ["--size"]),
+        _err("mg-out-is-dir", "mission generate", ["--out", "d"], ["--out"], {"d/keep": "x"}),
+        _err(
             "ms-out-readonly",
             "mission schema",
             ["--out", "ro/schema.json"],
@@ -1235,6 +1243,7 @@ def _bench_cases() -> list[Case]:
     o = ["--out", "o"]
     c = [
         _err("be-missing-mission", b, ["nope.yaml", *BENCH_ARGS, *o], ["nope.yaml"]),
+        _err("be-no-homes", b, ["--homes", "0", *BENCH_ARGS, *o], ["--homes"]),
         _err(
             "be-bad-mission",
             b,
@@ -1784,6 +1793,7 @@ COMMANDS = (
     "",
     "mission validate",
     "mission schema",
+    "mission generate",
     "map export",
     "map render",
     "map annotate",
