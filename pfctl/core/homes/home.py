@@ -42,6 +42,8 @@ DEFAULT_SIZE = ((10.0, 16.0), (8.0, 12.0))
 MIN_SIDE, MAX_SIDE = 3.0, 40.0
 #: Floor area per room of the default number of rooms, m².
 _AREA_PER_ROOM = 24.0
+#: The most rooms a home gets unless ``--rooms`` asks for more.
+_DEFAULT_MOST = 10
 #: Plans drawn before giving up.
 _ATTEMPTS = 60
 
@@ -156,7 +158,9 @@ def generate_home(
     rooms = options.rooms
     if rooms is None:
         guess = round(width * height / _AREA_PER_ROOM) + int(rng.integers(-1, 2))
-        rooms = int(np.clip(guess, min_rooms(kind), max_rooms(kind, width, height)))
+        rooms = int(
+            np.clip(min(guess, _DEFAULT_MOST), min_rooms(kind), max_rooms(kind, width, height))
+        )
     drawn = replace(options, rooms=rooms, size=(width, height), layout=kind)
     why = ""
     for attempt in range(_ATTEMPTS):
