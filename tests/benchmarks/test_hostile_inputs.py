@@ -7,8 +7,8 @@ import importlib
 import sys
 import textwrap
 from pathlib import Path
+from typing import Any
 
-import click
 import pytest
 import typer
 
@@ -24,9 +24,11 @@ def _leaf_commands() -> set[str]:
     """Every command of the CLI, as words after ``pfctl`` (``predict track`` is ``predict``)."""
     out: set[str] = set()
 
-    def walk(command: click.Command, words: tuple[str, ...]) -> None:
-        if isinstance(command, click.Group):
-            for name, sub in command.commands.items():
+    def walk(command: Any, words: tuple[str, ...]) -> None:
+        # typer carries its own click: its groups are not click.Group, so ask for subcommands
+        commands = getattr(command, "commands", None)
+        if commands is not None:
+            for name, sub in commands.items():
                 walk(sub, (*words, name))
         else:
             out.add(" ".join(words))
