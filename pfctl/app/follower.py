@@ -80,6 +80,7 @@ def build_follower(
         regions=regions,
         sensor_model=core_params(InverseSensorModel, mission.map.sensor_model),
         robot_radius=mission.robot.radius,
+        leaf_defaults={"oracle_search": {"range": mission.sensors.camera.range_max}},
         log=log,
         true_target=true_target,
     )

@@ -169,10 +169,7 @@ class Follower:
         self._writer.true_target = None
         self._true_target = true_target
         self._now = 0.0
-        defaults = {
-            "follow_target": {"distance": params.control.following_distance},
-            "oracle_search": {"range": perception.camera_range[1]},
-        }
+        defaults = {"follow_target": {"distance": params.control.following_distance}}
         defaults.update(leaf_defaults or {})
         self.root = build_tree(tree, leaf_factory(self.namespace, defaults), lambda: self._now)
         self.root.setup_with_descendants()

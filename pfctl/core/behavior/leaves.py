@@ -529,7 +529,9 @@ class OracleSearch(Action):
             return Status.FAILURE
         if self._goal is None or self.t - self._decided_at >= self.REPLAN_S:
             pose = self.bb.pose
-            lo, hi = float(self.params["range_min"]), float(self.params["range"])
+            reach = self.params["range"]
+            hi = math.inf if reach is None else float(reach)
+            lo = float(self.params["range_min"])
             place = nearest_viewpoint(
                 self.world.planner,
                 (pose.x, pose.y),
