@@ -20,6 +20,7 @@ from rich.console import Console
 from rich.progress import BarColumn, Progress, TextColumn
 
 from pfctl.app.follower import EpisodeResult, build_follower, run_follower, static_map
+from pfctl.app.oracle import privileged_leaves, refuse_on_real_robot, true_target_reader
 from pfctl.app.perception import build_perception, identity_params
 from pfctl.app.profiles import check_target_profile, load_target_profile
 from pfctl.app.spill import spill_log
@@ -153,7 +154,15 @@ def run_episode(
     perception with the camera ``detector`` and the human belief over the mission's static map,
     the target ``profile`` identified by Algorithm 2 (faces in a worker process as
     :func:`run_sim_episode` says; ``kind`` picks the mission's face timing for a simulated or a
-    real robot), ``truth`` (a simulator's) recorded beside each tick for the metrics."""
+    real robot), ``truth`` (a simulator's) recorded beside each tick for the metrics; the
+    target's true position is given to the follower only for a tree with the oracle baseline
+    (:mod:`pfctl.app.oracle`), and only with ``kind`` sim."""
+    true_target = None
+    if privileged_leaves(mission):
+        if kind != "sim" or truth is None:
+            refuse_on_real_robot(mission, mission.name)
+        else:
+            true_target = true_target_reader(truth)
     grid = static_map(mission)
     use_worker = mission.perception.identity.face_worker if face_worker is None else face_worker
     perception = build_perception(
@@ -171,7 +180,7 @@ def run_episode(
             identifier.worker.wait_ready()
         log = EpisodeLog(target_name=mission.scenario.target)
         spill_log(log)  # an episode of hours keeps its log in a file, not in memory
-        follower = build_follower(mission, robot, perception, log)
+        follower = build_follower(mission, robot, perception, log, true_target)
         params = metric_params(mission)
 
         def found(record: TickRecord) -> bool:

@@ -58,9 +58,14 @@ def static_map(mission: Mission) -> OccupancyGrid:
 
 
 def build_follower(
-    mission: Mission, robot: Robot, perception: Perception, log: EpisodeLog | None = None
+    mission: Mission,
+    robot: Robot,
+    perception: Perception,
+    log: EpisodeLog | None = None,
+    true_target: Callable[[], tuple[float, float] | None] | None = None,
 ) -> Follower:
-    """The mission's follower on ``robot`` with ``perception``."""
+    """The mission's follower on ``robot`` with ``perception``; ``true_target`` (privileged,
+    the simulator's, :mod:`pfctl.app.oracle`) only for a tree with the oracle baseline."""
     grid = static_map(mission)
     regions = RegionMap(mission.layout())
     # cached per geometry: made here, not in the tick of the first prediction or Algorithm 1
@@ -75,7 +80,9 @@ def build_follower(
         regions=regions,
         sensor_model=core_params(InverseSensorModel, mission.map.sensor_model),
         robot_radius=mission.robot.radius,
+        leaf_defaults={"oracle_search": {"range": mission.sensors.camera.range_max}},
         log=log,
+        true_target=true_target,
     )
 
 

@@ -51,6 +51,7 @@ from pfctl.app.episodes import (
     target_profile,
 )
 from pfctl.app.follower import EpisodeResult
+from pfctl.app.oracle import refuse_on_real_robot
 from pfctl.app.tracks_file import tracks_csv
 from pfctl.commands import check_seed
 from pfctl.core.metrics import (
@@ -176,6 +177,8 @@ def follow(
 
     _check_common(backend, duration, out, target, record, gui)
     loaded = load_mission(mission)
+    if backend == "hsr":
+        refuse_on_real_robot(loaded, str(mission))
     console = Console(stderr=True)
     profile = target_profile(loaded, target, seed, console, str(mission))
     if backend == "hsr":
@@ -370,6 +373,8 @@ def search(
             "pfctl sim serve-hsr --hide REGION)"
         )
     loaded = load_mission(mission)
+    if backend == "hsr":
+        refuse_on_real_robot(loaded, str(mission))
     names = [r.name for r in loaded.map.regions]
     if region is not None and region not in names:
         raise UserError(f"--region {region}: unknown region (regions: {', '.join(names)})")

@@ -23,13 +23,15 @@ timed) on its own:
 6. :meth:`~Follower.log_tick` — a :class:`~pfctl.core.episode.TickRecord`: awareness (visible /
    tracked / lost / predicted / searching), the active action, the base mode, the gaze.
 
-The follower never reads ground truth. :meth:`close` stops the base.
+The follower never reads ground truth, with one named exception: the oracle baseline's
+``true_target`` (see :class:`Follower`), given only when its tree asks for it. :meth:`close`
+stops the base.
 """
 
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -138,7 +140,12 @@ class Follower:
         robot_radius: float = 0.215,
         leaf_defaults: dict[str, dict[str, Any]] | None = None,
         log: EpisodeLog | None = None,
+        true_target: Callable[[], tuple[float, float] | None] | None = None,
     ) -> None:
+        """``true_target`` is **privileged**: the simulator's truth of where the target is,
+        given only for a tree with the oracle baseline's ``oracle_search`` (the app layer
+        decides); it is written to the blackboard key of that name, which only that leaf reads,
+        and nothing else of the follower calls it."""
         self.robot = robot
         self.perception = perception
         self.params = params
@@ -159,6 +166,8 @@ class Follower:
         self._writer.world = self.world
         self._writer.intents = self.intents
         self._writer.waypoint = None
+        self._writer.true_target = None
+        self._true_target = true_target
         self._now = 0.0
         defaults = {"follow_target": {"distance": params.control.following_distance}}
         defaults.update(leaf_defaults or {})
@@ -287,6 +296,8 @@ class Follower:
         w.target = target
         w.last_seen = self._last_seen
         w.prediction = self._prediction
+        if self._true_target is not None:
+            w.true_target = self._true_target()
         self.intents.begin(obs.stamp, obs.pose)
         self.root.tick_once()
         self.intents.end()

@@ -20,6 +20,7 @@ from typing import Annotated, Literal
 import shapely
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
+from pfctl.core.behavior.leaves import PRIVILEGED_LEAVES
 from pfctl.core.control import ControlParams
 from pfctl.core.follower import FollowerParams, PredictionParams
 from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region
@@ -399,6 +400,23 @@ class Mission(MissionModel):
                     )
                 )
         raise_first(issues)
+        return self
+
+    @model_validator(mode="after")
+    def _privileged_in_sim_only(self) -> Mission:
+        """A mission set up for the real robot (``backend.hsr`` given) names no privileged leaf
+        (the oracle baseline's ``oracle_search`` reads the simulator's ground truth)."""
+        privileged = sorted(self.behavior.tree.leaf_names() & set(PRIVILEGED_LEAVES))
+        if privileged and "hsr" in self.backend.model_fields_set:
+            raise_first(
+                [
+                    (
+                        ("behavior", "tree"),
+                        f"{privileged[0]} reads the simulator's ground truth (privileged): "
+                        "expected no such leaf in a mission for the real robot (backend.hsr)",
+                    )
+                ]
+            )
         return self
 
     def layout(self) -> HouseLayout:

@@ -169,6 +169,10 @@ class TreeNode(MissionModel):
         for child in self.children:
             yield from child.walk()
 
+    def leaf_names(self) -> set[str]:
+        """The names of the condition and action leaves in this subtree."""
+        return {str(node.body) for node in self.walk() if node.is_leaf}
+
     def size(self) -> int:
         """The number of nodes in this subtree, this one included."""
         return sum(1 for _ in self.walk())

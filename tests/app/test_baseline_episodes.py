@@ -1,8 +1,9 @@
 """The reactive baseline against the paper's tree on the paper's episode (seed 1, §III-B): both
 follow Alice out of the kitchen and lose her at the office door; the reactive baseline
 (``missions/baselines/house_reactive.yaml``) then stops and never searches, while the paper's
-tree (Fig. 2) goes to the prediction and searches. One target profile learned for both runs;
-15 s simulated each."""
+tree (Fig. 2) goes to the prediction and searches; the oracle (privileged) drives to where she
+is in sight and re-finds her. One target profile learned for all runs; 15 s simulated each (35 s
+for the oracle's re-find)."""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ from pfctl.app.perception import identity_params
 from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimRobot
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS
-from pfctl.core.episode import TickRecord
+from pfctl.core.episode import EpisodeLog, TickRecord
+from pfctl.core.metrics import follow_metrics
 from pfctl.core.perception.identity.profile import TargetProfile, learn_profile
 from pfctl.mission import load_mission
 
@@ -38,11 +40,15 @@ def profile() -> TargetProfile:
     return learn_profile(learned.appearances, params)
 
 
-def _episode(path: Path, profile: TargetProfile) -> list[TickRecord]:
+def _episode(path: Path, profile: TargetProfile, seconds: float = SECONDS) -> list[TickRecord]:
+    return _run(path, profile, seconds).ticks
+
+
+def _run(path: Path, profile: TargetProfile, seconds: float) -> EpisodeLog:
     mission = load_mission(path)
     with SimRobot(sim_config(mission, SEED)) as robot:
-        result = run_sim_episode(mission, robot, profile, SECONDS)
-    return result.log.ticks
+        result = run_sim_episode(mission, robot, profile, seconds)
+    return result.log
 
 
 def _after_loss(ticks: list[TickRecord]) -> list[TickRecord]:
@@ -81,3 +87,17 @@ def test_the_reactive_baseline_stops_after_the_loss_where_the_paper_tree_searche
     assert len(searching) > 2.0 * 10
     assert {r.action for r in searching} & {"go_to_prediction", "look_around", "waypoint_search"}
     assert _farthest(paper) > 0.8
+
+
+def test_the_oracle_refinds_her_from_where_she_is_in_sight(profile: TargetProfile) -> None:
+    """The oracle baseline (issue 22, item 4): lost at the office door like the paper's tree, it
+    drives by her true position to where she is in sight and re-identifies her (35 s run)."""
+    log = _run(MISSIONS / "baselines" / "house_oracle.yaml", profile, 35.0)
+    metrics = follow_metrics(log)
+    assert metrics.losses >= 1 and 8.0 < metrics.loss_times[0] < 12.0
+    (found, *_) = metrics.reacquisitions
+    assert found.time_to_refind < 25.0, metrics.reacquisitions
+    lost = [r for r in _after_loss(log.ticks) if r.t < found.t_found]
+    assert {r.action for r in lost} == {"oracle_search"}
+    assert {r.awareness for r in lost} <= {"searching", "tracked"}
+    assert metrics.identity_switches == 0 and metrics.collisions == 0

@@ -3,7 +3,10 @@
 The follower (:mod:`pfctl.core.follower`) writes the state keys once per tick, before the tree
 is ticked; leaves (:mod:`pfctl.core.behavior.leaves`) declare which of them they read or write:
 they read the state and the world model and write their intents (``intents``) — never a command
-to the robot — and way-point search writes its latest decision (``waypoint``). Each
+to the robot — and way-point search writes its latest decision (``waypoint``). One key is
+privileged: ``true_target``, the simulator's truth of where the target is, which the app layer
+fills only for a tree that names the oracle baseline's ``oracle_search``, the only leaf that
+declares it (a leaf reads only the keys it declares). Each
 follower has its own namespace (:func:`new_namespace`), so two followers in one process (tests,
 campaigns) never share state; :func:`clear_namespace` drops one when its follower closes.
 """
@@ -29,6 +32,8 @@ KEYS: dict[str, str] = {
     "the people it tracks, for the leaves' control laws and Algorithm 1",
     "intents": "Intents: what the leaves want the base and the head to do this tick",
     "waypoint": "WaypointDecision | None: Algorithm 1's latest way-point (waypoint_search)",
+    "true_target": "PRIVILEGED (simulator's ground truth) tuple[float, float] | None: where the "
+    "target really is; filled only for a tree naming oracle_search, the one leaf that reads it",
 }
 
 _counter = itertools.count(1)

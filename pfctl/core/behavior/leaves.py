@@ -31,6 +31,7 @@ from pfctl.core.behavior.spec import LeafSpec, param
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.regions import WaypointDecision
+from pfctl.core.perception.viewpoints import nearest_viewpoint
 
 
 class Leaf(py_trees.behaviour.Behaviour):
@@ -480,6 +481,77 @@ class GoToLastSeen(Action):
         return status
 
 
+class OracleSearch(Action):
+    """The oracle baseline (issue 22): **privileged**, simulator only. Reads the target's true
+    position (blackboard key ``true_target``, the simulator's ground truth, which no other leaf
+    declares) and drives to the nearest place from which she is in sight
+    (:func:`~pfctl.core.perception.viewpoints.nearest_viewpoint`: free for the robot, within
+    ``range`` of her, no wall or furniture between), re-planned every ``REPLAN_S`` seconds as
+    she walks, the head on her true position; its time to re-find is the floor a search can be
+    compared against. RUNNING until the target is detected (SUCCESS); FAILURE without the truth
+    or when no such place can be reached."""
+
+    spec = LeafSpec(
+        "oracle_search",
+        "action",
+        "PRIVILEGED, simulator only (reads the ground truth): drive to the nearest place from "
+        "which the target's true position is in sight, head on her; the oracle baseline.",
+        (
+            param(
+                "range",
+                None,
+                "how far she may be from the place, m (default the camera's range_max)",
+                minimum=0.5,
+            ),
+            param("range_min", 0.6, "how near she may be to the place, m", minimum=0.0),
+            param(
+                "clearance",
+                0.25,
+                "the line of sight keeps this far from walls and furniture, m",
+                minimum=0.0,
+            ),
+            param("tolerance", 0.3, "arrival distance at the place, m", minimum=0.05),
+        ),
+    )
+    reads = (*Leaf.reads, "true_target")
+
+    REPLAN_S: ClassVar[float] = 1.0
+
+    def initialise(self) -> None:
+        self._goal: tuple[float, float] | None = None
+        self._decided_at = -math.inf
+
+    def act(self) -> Status:
+        if self.visible():
+            return Status.SUCCESS
+        truth: tuple[float, float] | None = self.bb.true_target
+        if truth is None:
+            return Status.FAILURE
+        if self._goal is None or self.t - self._decided_at >= self.REPLAN_S:
+            pose = self.bb.pose
+            reach = self.params["range"]
+            hi = math.inf if reach is None else float(reach)
+            lo = float(self.params["range_min"])
+            place = nearest_viewpoint(
+                self.world.planner,
+                (pose.x, pose.y),
+                truth,
+                hi,
+                min(lo, hi / 2),
+                float(self.params["clearance"]),
+            )
+            self._decided_at = self.t
+            self._goal = None if place is None else place.xy
+        self.intents.look_at(truth, "oracle")
+        if self._goal is None:
+            self.intents.stop()
+            return Status.FAILURE
+        if self.intents.go_to(self._goal, self.params["tolerance"]) == "failed":
+            self._goal = None
+            return Status.FAILURE
+        return Status.RUNNING
+
+
 class Stop(Action):
     """Stop the base; SUCCESS."""
 
@@ -506,6 +578,7 @@ LEAF_CLASSES: dict[str, type[Leaf]] = {
         LookAround,
         WaypointSearch,
         GoToLastSeen,
+        OracleSearch,
         Stop,
     )
 }
@@ -513,7 +586,11 @@ LEAF_CLASSES: dict[str, type[Leaf]] = {
 #: Search actions: when one of them runs while the target is lost, the robot is "predicted"
 #: (going to the prediction and looking there) or "searching" (Algorithm 1).
 PREDICTION_ACTIONS = ("go_to_prediction", "look_around")
-SEARCH_ACTIONS = ("waypoint_search", "go_to_last_seen")
+SEARCH_ACTIONS = ("waypoint_search", "go_to_last_seen", "oracle_search")
+
+#: Leaves that read the simulator's ground truth (the oracle baseline): a tree naming one runs
+#: only in the simulator, which gives it the truth; the real robot refuses it.
+PRIVILEGED_LEAVES = (OracleSearch.spec.name,)
 
 
 def leaf_factory(
@@ -540,6 +617,7 @@ def leaf_factory(
 __all__ = [
     "LEAF_CLASSES",
     "PREDICTION_ACTIONS",
+    "PRIVILEGED_LEAVES",
     "SEARCH_ACTIONS",
     "Action",
     "Leaf",

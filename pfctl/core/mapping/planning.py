@@ -238,6 +238,21 @@ class GridPlanner:
         keep[1:][np.all(np.abs(np.diff(raw, axis=0)) < 1e-12, axis=1)] = False
         return self._shortcut(raw[keep])
 
+    def distances_from(self, start_xy: ArrayLike) -> NDArray[np.float64]:
+        """The cost (m) of the planner's shortest path from ``start_xy`` to every cell (shape
+        ``geometry.shape``; ``inf`` where no path reaches): the metres :meth:`plan`'s Dijkstra
+        minimises, step lengths weighted near obstacles. A start inside the inflated obstacles
+        is moved to the nearest free cell first (:data:`START_SNAP`); one with none near is
+        :class:`NoPathError`."""
+        snapped = self.nearest_free(np.asarray(start_xy, dtype=float).reshape(2))
+        if snapped is None:
+            raise NoPathError(f"start {tuple(np.round(start_xy, 2))} is not near any free cell")
+        g = self._build_graph()
+        r, c = (int(v) for v in self.geometry.world_to_cell(snapped))
+        dist = csgraph.dijkstra(g.graph, directed=False, indices=r * self.geometry.width + c)
+        out: NDArray[np.float64] = np.asarray(dist, dtype=float).reshape(self.geometry.shape)
+        return out
+
     def _segment_clearance(self, a: np.ndarray, b: np.ndarray) -> float:
         """The smallest clearance along segment ``a → b`` (sampled every third of a cell)."""
         step = self.geometry.resolution / 3.0

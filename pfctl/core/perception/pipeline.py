@@ -4,7 +4,13 @@ One :class:`Perception` holds the parts of the paper's perception and runs them 
 message, in the order the follower needs them:
 
 - a **scan** → :class:`~pfctl.core.perception.legs.detector.LegDetector` (segments, Arras et
-  al. features, random forest, leg pairs) → person candidates →
+  al. features, random forest, leg pairs) → person candidates, and a lone leg (one leg segment:
+  a person standing side-on shows one) within :data:`SINGLE_LEG_DISTANCE` of a person the
+  camera saw in its latest frame (at most :data:`CAMERA_MAX_AGE` old) and whose legs made no
+  candidate as a candidate too, at
+  the two positions fused (weighted by the tracker's laser and camera noise) — the camera says
+  someone stands there, the leg that it is a person's legs the laser sees; lone legs far from
+  any camera detection (a table's legs) stay no one →
   :class:`~pfctl.core.perception.tracking.MultiPersonTracker` (``laser`` detections, the scan's
   field of view with its returns as occluders);
 - an **RGB-D frame** → a :class:`~pfctl.core.perception.vision.PersonDetector` → 3-D people →
@@ -23,10 +29,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+import numpy as np
+
 from pfctl.core.episode import TrackRow
 from pfctl.core.perception.belief import HumanBelief
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier, TrackIdentity
-from pfctl.core.perception.legs.detector import LegDetections, LegDetector
+from pfctl.core.perception.legs.detector import SINGLE_LEG_FACTOR, LegDetections, LegDetector
 from pfctl.core.perception.tracking import (
     Detection,
     FieldOfView,
@@ -36,6 +44,12 @@ from pfctl.core.perception.tracking import (
 )
 from pfctl.core.perception.vision import PersonDetection, PersonDetector
 from pfctl.core.robot import LaserScan, Observation, RgbdFrame
+
+#: A lone leg this close to a person the camera sees is that person's, metres.
+SINGLE_LEG_DISTANCE = 0.4
+#: A camera frame's people are used for the lone legs of the scans up to this much later, s
+#: (a frame period and a half at the camera's 10 Hz).
+CAMERA_MAX_AGE = 0.15
 
 
 @dataclass(frozen=True)
@@ -72,11 +86,14 @@ class Perception:
         self._leg_tracks: set[int] = set()
         self.last_legs: LegDetections | None = None
         self.last_sightings: tuple[CameraSighting, ...] = ()
+        self._camera_people: tuple[float, np.ndarray] | None = None
+        """The latest frame's stamp and the floor positions ``(n, 2)`` of its people."""
 
     def on_scan(self, scan: LaserScan) -> LegDetections:
         """Detect legs in ``scan`` and update the tracks with the person candidates."""
         found = self.legs.detect(scan)
         detections = [Detection(p.x, p.y, p.probability) for p in found.people]
+        detections += self._legs_beside_camera_people(found)
         ids = self.tracker.update("laser", detections, FieldOfView.from_scan(scan), scan.stamp)
         self._leg_tracks.update(i for i in ids if i is not None)
         self._forget_deleted()
@@ -90,6 +107,7 @@ class Perception:
         people = self.detector.detect(frame)
         fov = FieldOfView.from_frame(frame, self.camera_range[1], self.camera_range[0])
         detections = [Detection(d.position[0], d.position[1], d.score) for d in people]
+        self._camera_people = (frame.stamp, np.array([[d.x, d.y] for d in detections]))
         ids = self.tracker.update("camera", detections, fov, frame.stamp)
         self._forget_deleted()
         identities: dict[int, TrackIdentity] = {}
@@ -109,6 +127,43 @@ class Perception:
             self.belief.update(fov, [d.position[:2] for d in people], frame.stamp)
         self.last_sightings = tuple(sightings)
         return self.last_sightings
+
+    def _legs_beside_camera_people(self, found: LegDetections) -> list[Detection]:
+        """Person candidates from lone legs beside the people of the latest camera frame (the
+        module docstring): each person the camera saw with no leg candidate within
+        :data:`SINGLE_LEG_DISTANCE` takes the nearest lone leg within that distance, at the
+        inverse-variance mean of the two positions, with the single leg's confidence (P(leg) ×
+        ``SINGLE_LEG_FACTOR``)."""
+        recent = self._camera_people
+        if not found.lone_legs or recent is None or len(recent[1]) == 0:
+            return []
+        stamp, people = recent
+        if not 0.0 <= found.stamp - stamp <= CAMERA_MAX_AGE:
+            return []
+        if found.people:  # a person whose legs already made a candidate needs none
+            cands = np.array([[c.x, c.y] for c in found.people])
+            gap = np.hypot(
+                people[:, None, 0] - cands[None, :, 0], people[:, None, 1] - cands[None, :, 1]
+            )
+            people = people[gap.min(axis=1) > SINGLE_LEG_DISTANCE]
+            if len(people) == 0:
+                return []
+        legs = np.array([[leg.x, leg.y] for leg in found.lone_legs])
+        d = np.hypot(people[:, None, 0] - legs[None, :, 0], people[:, None, 1] - legs[None, :, 1])
+        w_leg = self.tracker.params.laser_noise**-2
+        w_cam = self.tracker.params.camera_noise**-2
+        out: list[Detection] = []
+        taken: set[int] = set()
+        for i in np.argsort(d.min(axis=1), kind="stable"):
+            near = [j for j in np.argsort(d[i], kind="stable") if j not in taken]
+            if not near or d[i, near[0]] > SINGLE_LEG_DISTANCE:
+                continue
+            j = int(near[0])
+            taken.add(j)
+            xy = (w_leg * legs[j] + w_cam * people[i]) / (w_leg + w_cam)
+            p = found.lone_legs[j].probability * SINGLE_LEG_FACTOR
+            out.append(Detection(float(xy[0]), float(xy[1]), p))
+        return out
 
     def on_observation(self, observation: Observation) -> None:
         """Feed what one :class:`~pfctl.core.robot.Observation` brings (scan, frame or both)."""

@@ -1,12 +1,13 @@
 """The core options the baselines of ``missions/baselines/`` need, each changing the decision as
 intended on a small constructed case: the nearest frontier instead of Eq. 3's utility, the
 constant-velocity prediction instead of the SVR (§II-E) in the follower, and the trees of the
-reactive and go-to-last-seen baselines on the real leaves."""
+reactive, go-to-last-seen and oracle baselines on the real leaves."""
 
 from __future__ import annotations
 
 import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -20,13 +21,21 @@ from shapely.ops import unary_union
 
 from pfctl.app.follower import build_follower, follower_params
 from pfctl.core.behavior.blackboard import KEYS, Sighting, TargetState, new_namespace
-from pfctl.core.behavior.leaves import WaypointSearch, leaf_factory
+from pfctl.core.behavior.leaves import (
+    LEAF_CLASSES,
+    PRIVILEGED_LEAVES,
+    OracleSearch,
+    WaypointSearch,
+    leaf_factory,
+)
 from pfctl.core.behavior.tree import build_tree
 from pfctl.core.control import ControlParams
 from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.paths import distance_fields, traversability
+from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, WaypointDecision, waypoint_search
+from pfctl.core.perception.viewpoints import nearest_viewpoint
 from pfctl.core.prediction.models import make_model
 from pfctl.core.robot import Pose2D
 from pfctl.mission import load_mission
@@ -225,6 +234,9 @@ class FakeIntents:
     def set_pan(self, pan: float) -> None:
         self.calls.append(("pan", pan))
 
+    def look_at(self, xy: tuple[float, float], source: str = "target") -> None:
+        self.calls.append(("look_at", xy))
+
     def kinds(self) -> list[str]:
         out, self.calls = [c[0] for c in self.calls if c[0] != "claim"], []
         return out
@@ -238,19 +250,23 @@ class TreeRig:
         self.ns = new_namespace()
         self.now = 0.0
         self.intents = FakeIntents()
-        self.root = build_tree(
-            layout, leaf_factory(self.ns, {"follow_target": {"distance": 1.0}}), lambda: self.now
-        )
+        defaults = {"follow_target": {"distance": 1.0}, "oracle_search": {"range": 5.0}}
+        self.root = build_tree(layout, leaf_factory(self.ns, defaults), lambda: self.now)
         self.root.setup_with_descendants()
         self.bb = py_trees.blackboard.Client(name="rig", namespace=self.ns)
         for key in KEYS:
             self.bb.register_key(key, access=Access.WRITE)
 
     def tick(
-        self, now: float, target: TargetState | None = None, seen: Sighting | None = None
+        self,
+        now: float,
+        target: TargetState | None = None,
+        seen: Sighting | None = None,
+        pose: Pose2D | None = None,
     ) -> tuple[Status, str | None]:
         self.now = now
-        self.bb.t, self.bb.pose, self.bb.target = now, Pose2D(0.0, 0.0), target
+        self.bb.t, self.bb.target = now, target
+        self.bb.pose = pose if pose is not None else Pose2D(0.0, 0.0)
         self.bb.last_seen, self.bb.prediction, self.bb.intents = seen, None, self.intents
         self.root.tick_once()
         tip = self.root.tip()
@@ -303,3 +319,55 @@ def test_the_last_seen_tree_drives_there_then_looks_around_and_keeps_its_arrival
     assert rig.intents.kinds().count("go_to") == 1
     # seen again: follow
     assert rig.tick(11.0, _target(11.0), other) == (Status.RUNNING, "follow_target")
+
+
+# --------------------------------------------------------------------------------------------
+# the oracle (privileged) on the real leaf
+# --------------------------------------------------------------------------------------------
+
+
+def _two_rooms() -> GridPlanner:
+    """8 m × 4 m, walled round, a wall at x = 4 m with a 1 m door at y 0.5–1.5 m."""
+    p = np.zeros((round(4 / RES), round(8 / RES)))
+    p[:2, :] = p[-2:, :] = p[:, :2] = p[:, -2:] = 1.0
+    p[:, 79:81] = 1.0
+    p[10:30, 79:81] = 0.0
+    return GridPlanner(OccupancyGrid.from_probabilities(p, RES), 0.2)
+
+
+def test_only_the_oracle_leaf_reads_the_truth() -> None:
+    readers = [c for c in LEAF_CLASSES.values() if "true_target" in c.reads]
+    assert readers == [OracleSearch] and OracleSearch.spec.name in PRIVILEGED_LEAVES
+    assert "PRIVILEGED" in OracleSearch.spec.doc
+
+
+def test_the_oracle_drives_to_the_nearest_place_that_sees_her_and_replans_as_she_walks() -> None:
+    rig = TreeRig("oracle.yaml")
+    planner = _two_rooms()
+    rig.bb.world = SimpleNamespace(planner=planner)
+    here = Pose2D(1.0, 3.0)
+    assert rig.tick(0.0, _target(0.0), pose=here) == (Status.RUNNING, "follow_target")
+    rig.intents.kinds()
+    seen = Sighting(0.0, (2.0, 1.0), np.array([[0.0, 2.0, 1.0]]))
+    # no truth (the app gives none): the oracle fails, nothing is driven
+    rig.bb.true_target = None
+    assert rig.tick(0.5, None, seen, here) == (Status.FAILURE, "oracle_search")
+    assert "go_to" not in rig.intents.kinds()
+    # the truth: she is in the east room; the goal is the nearest place with her in sight
+    her = (6.0, 3.0)
+    rig.bb.true_target = her
+    assert rig.tick(1.0, None, seen, here) == (Status.RUNNING, "oracle_search")
+    want = nearest_viewpoint(planner, (here.x, here.y), her, 5.0, 0.6, 0.25)
+    assert want is not None and ("go_to", want.xy) in rig.intents.calls
+    assert ("look_at", her) in rig.intents.calls
+    rig.intents.kinds()
+    # she walks on: the place is kept for a second, then re-planned (head on her at once)
+    rig.bb.true_target = (7.0, 1.0)
+    rig.tick(1.5, None, seen, here)
+    assert ("go_to", want.xy) in rig.intents.calls and ("look_at", (7.0, 1.0)) in rig.intents.calls
+    rig.intents.kinds()
+    rig.tick(2.1, None, seen, here)
+    again = nearest_viewpoint(planner, (here.x, here.y), (7.0, 1.0), 5.0, 0.6, 0.25)
+    assert again is not None and again.xy != want.xy and ("go_to", again.xy) in rig.intents.calls
+    # seen: follow again
+    assert rig.tick(3.0, _target(3.0), seen, here) == (Status.RUNNING, "follow_target")

@@ -17,7 +17,7 @@ gives
 4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
    (greedy matching by distance), into person candidates at the midpoint; a leg left alone
    with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
-   its confidence halved.
+   its confidence halved; the other lone legs are reported apart (``lone_legs``).
 
 Legs and people are reported in the map frame (through ``scan.pose``). A leg's position is its
 segment's centroid moved :data:`LEG_DEPTH` farther along the beam: the laser sees the front of
@@ -74,6 +74,11 @@ class LegParams:
     )
     single_leg_probability: float = 0.8
     """A leg without a partner is still a person candidate when its P(leg) is at least this."""
+    lone_leg_probability: float = 0.25
+    """A segment that made no candidate is a lone leg (:attr:`LegDetections.lone_legs`) when
+    its P(leg) is at least this, also below ``probability``: beside a person the camera sees it
+    is that person's, and the camera's detection is the evidence the forest's score lacks (a
+    target standing side-on shows one segment for both legs, scored about 0.3-0.6)."""
     history_scans: int = param(
         10,
         "P(leg) of a segment is averaged over this many scans of its track (1: each scan alone).",
@@ -108,6 +113,12 @@ class LegDetections:
     stamp: float
     legs: tuple[Leg, ...]
     people: tuple[PersonCandidate, ...]
+    lone_legs: tuple[Leg, ...] = ()
+    """The leg segments that made no candidate: legs with no partner within ``pair_distance``
+    and P(leg) below ``single_leg_probability``, and segments scored from
+    ``lone_leg_probability`` up to ``probability`` — one segment of a person standing side-on,
+    or clutter (a table's leg). Alone they are no one; the perception counts one beside a
+    person the camera sees (:class:`~pfctl.core.perception.pipeline.Perception`)."""
 
 
 @dataclass(frozen=True)
@@ -193,26 +204,31 @@ class LegDetector:
             self.evidence.reset()
 
     def detect(self, scan: LaserScan) -> LegDetections:
-        """Legs (P ≥ ``probability``) and the people they make in one scan."""
+        """Legs (P ≥ ``probability``) and the people they make in one scan, and the lone legs
+        (:attr:`LegDetections.lone_legs`)."""
         c = classify_segments(scan, self.model, self.params)
         if self.evidence is not None:
             seen = np.flatnonzero(c.classified)
             where = scan.pose.transform(c.segments.centroids()[seen])
             c.probability[seen] = self.evidence.update(where, c.probability[seen])
-        is_leg = c.classified & (c.probability >= self.params.probability)
-        idx = np.flatnonzero(is_leg)
+        low = min(self.params.probability, self.params.lone_leg_probability)
+        idx = np.flatnonzero(c.classified & (c.probability >= low))
         if len(idx) == 0:
             return LegDetections(scan.stamp, (), ())
         local = c.segments.centroids()[idx]
         rng = np.maximum(np.hypot(*local.T), 1e-9)
         local = local * ((rng + LEG_DEPTH) / rng)[:, None]
-        world = scan.pose.transform(local)
-        prob = c.probability[idx]
+        found = scan.pose.transform(local)
+        p_found = c.probability[idx]
+        is_leg = p_found >= self.params.probability
+        world, prob = found[is_leg], p_found[is_leg]
         legs = tuple(
             Leg(float(x), float(y), float(p)) for (x, y), p in zip(world, prob, strict=True)
         )
         people = []
-        for group in pair_legs(world, prob, self.params):
+        groups = pair_legs(world, prob, self.params)
+        grouped = {g for group in groups for g in group}
+        for group in groups:
             pts = world[list(group)]
             p = float(prob[list(group)].mean())
             if len(group) == 1:
@@ -221,7 +237,13 @@ class LegDetector:
             people.append(
                 PersonCandidate(float(mid[0]), float(mid[1]), p, tuple(legs[g] for g in group))
             )
-        return LegDetections(scan.stamp, legs, tuple(people))
+        lone = [leg for i, leg in enumerate(legs) if i not in grouped]
+        lone += [
+            Leg(float(x), float(y), float(p))
+            for (x, y), p in zip(found[~is_leg], p_found[~is_leg], strict=True)
+            if p >= self.params.lone_leg_probability
+        ]
+        return LegDetections(scan.stamp, legs, tuple(people), tuple(lone))
 
 
 __all__ = [

@@ -1,0 +1,121 @@
+"""The single-leg case of the perception (issue 22, item 5) on a constructed scan and camera
+detection: a target standing side-on shows the laser one segment for both legs, scored below the
+leg threshold; beside a person the camera sees it becomes a person candidate at the fused
+position (so Algorithm 2's "has legs" holds for her track), while a lone leg-like segment far
+from any camera detection (a table's leg) stays no one."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pfctl.core.perception.legs.detector import LegDetector, LegParams
+from pfctl.core.perception.pipeline import CAMERA_MAX_AGE, SINGLE_LEG_DISTANCE, Perception
+from pfctl.core.perception.tracking import MultiPersonTracker
+from pfctl.core.perception.vision import PersonDetection
+from pfctl.core.robot import CameraInfo, LaserScan, Pose2D, RgbdFrame
+
+#: Where she stands side-on, and a table's leg 2 m to her right.
+HER = (3.0, 0.0)
+TABLE_LEG = (2.5, -2.0)
+#: The forest's score of both segments: below the leg threshold (0.5), as her side-on segment
+#: is scored in the simulated house (0.3-0.6 per scan).
+SCORE = 0.4
+
+
+class FixedScore:
+    """A leg model that gives every segment the same P(leg)."""
+
+    def predict_proba(self, features: np.ndarray) -> np.ndarray:
+        return np.full(len(features), SCORE)
+
+
+class SeesAt:
+    """A camera person detector that sees one person at ``xy`` (or no one)."""
+
+    def __init__(self, xy: tuple[float, float] | None) -> None:
+        self.xy = xy
+
+    def detect(self, frame: RgbdFrame) -> list[PersonDetection]:
+        if self.xy is None:
+            return []
+        return [PersonDetection((0, 0, 1, 1), (self.xy[0], self.xy[1], 1.0))]
+
+
+def _scan(stamp: float) -> LaserScan:
+    """A 360° scan from the origin that sees two 0.16 m wide arcs (one segment each): her two
+    legs as one, side-on, and the table's leg; nothing else within range."""
+    inc = math.radians(0.25)
+    angles = -math.pi + inc * np.arange(1440)
+    ranges = np.full(len(angles), np.inf)
+    for cx, cy in (HER, TABLE_LEG):
+        d, bearing = math.hypot(cx, cy), math.atan2(cy, cx)
+        half = math.asin(0.08 / d)
+        on = np.abs(angles - bearing) <= half
+        ranges[on] = d - 0.06 * np.cos((angles[on] - bearing) / half * math.pi / 2)
+    return LaserScan(stamp, -math.pi, inc, 0.05, 20.0, ranges, Pose2D(0.0, 0.0, 0.0))
+
+
+def _frame(stamp: float) -> RgbdFrame:
+    """A frame from a camera at the origin looking along +x (contents unused by the stub)."""
+    rotation = np.array([[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]])
+    info = CameraInfo(320, 240, (277.0, 0.0, 160.0, 0.0, 277.0, 120.0, 0.0, 0.0, 1.0))
+    return RgbdFrame(
+        stamp,
+        np.zeros((240, 320, 3), np.uint8),
+        np.full((240, 320), np.inf, np.float32),
+        info,
+        (0.0, 0.0, 1.0),
+        rotation,
+    )
+
+
+def _perception(camera_xy: tuple[float, float] | None) -> Perception:
+    legs = LegDetector(FixedScore(), LegParams(history_scans=1))  # type: ignore[arg-type]
+    return Perception(legs, MultiPersonTracker(), detector=SeesAt(camera_xy))
+
+
+def _run(perception: Perception, seconds: float = 1.0, frame_lag: float = 0.025) -> None:
+    """Frames at 10 Hz, each followed ``frame_lag`` s later by a scan."""
+    for k in range(round(seconds * 10)):
+        t = 0.1 * k
+        perception.on_frame(_frame(t))
+        perception.on_scan(_scan(t + frame_lag))
+
+
+def test_both_segments_are_lone_legs_and_alone_no_one() -> None:
+    found = _perception(None).on_scan(_scan(0.0))
+    assert found.legs == () and found.people == ()
+    lone = sorted((round(leg.x, 1), round(leg.y, 1)) for leg in found.lone_legs)
+    assert lone == [(2.5, -2.0), (3.0, 0.0)]
+    assert all(leg.probability == pytest.approx(SCORE) for leg in found.lone_legs)
+
+
+def test_a_lone_leg_beside_a_camera_person_is_her_candidate_and_the_table_leg_no_one() -> None:
+    camera_xy = (HER[0] + 0.2, HER[1] + 0.15)  # the camera's position is 0.25 m off
+    perception = _perception(camera_xy)
+    _run(perception)
+    tracks = perception.tracks(confirmed_only=False)
+    assert len(tracks) == 1  # hers: the table's leg made no track
+    (track,) = tracks
+    assert perception.has_legs(track.id)  # Algorithm 2 need not wait for legs
+    # fused: much nearer the leg (laser noise 0.05 m) than the camera (0.15 m)
+    assert math.dist(track.position, HER) < 0.1 < math.dist(track.position, camera_xy)
+
+
+def test_without_the_leg_her_track_has_no_legs() -> None:
+    """The same camera person without the fusion's leg (too far from it): no legs."""
+    far = (HER[0] + SINGLE_LEG_DISTANCE + 0.2, HER[1])
+    perception = _perception(far)
+    _run(perception)
+    tracks = perception.tracks(confirmed_only=False)
+    assert len(tracks) == 1 and not perception.has_legs(tracks[0].id)
+
+
+def test_a_stale_camera_detection_makes_no_candidate() -> None:
+    perception = _perception((HER[0] + 0.1, HER[1]))
+    _run(perception, frame_lag=CAMERA_MAX_AGE + 0.02)
+    (track,) = perception.tracks(confirmed_only=False)
+    assert not perception.has_legs(track.id)
