@@ -279,8 +279,26 @@ def auto_layout(
     if reference is not None:
         seg = name_after(seg, reference)
     layout = seg.layout()
-    check_layout(layout.regions, layout.doors, geometry.resolution)
-    return layout, []
+    try:
+        check_layout(layout.regions, layout.doors, geometry.resolution)
+        return layout, []
+    except UserError:
+        pass
+    # a proposed door the mission rules reject is dropped, not the whole proposal
+    check_layout(layout.regions, (), geometry.resolution)
+    kept: list[Door] = []
+    dropped: list[str] = []
+    for d in layout.doors:
+        try:
+            check_layout(layout.regions, (d,), geometry.resolution)
+            kept.append(d)
+        except UserError:
+            dropped.append(f"{d.between[0]}|{d.between[1]}")
+    warnings = [
+        f"--auto: dropped {len(dropped)} proposed door(s) not on the wall their rooms share: "
+        + ", ".join(dropped)
+    ]
+    return HouseLayout(regions=layout.regions, doors=tuple(kept)), warnings
 
 
 # --------------------------------------------------------------------------------------------

@@ -25,7 +25,8 @@ implementation, and analysis" (§III-B there), with a watershed growth step:
    filled, and the rooms simplified together as a coverage (``shapely.coverage_simplify``), so
    neighbouring rooms keep sharing exactly the same edge.
 4. **Doors.** Wherever two rooms' free cells touch, a door is proposed: the part of their shared
-   polygon edge that spans the touching cells.
+   polygon edge that spans the touching cells, on one straight piece of it (the piece most of
+   them are nearest to), so the door lies on the wall the two polygons share.
 
 Rooms are named ``room_1``, ``room_2``, … by their centroid, south to north then west to east
 (rows of ``name_row_height`` metres), or after the best-matching region of a reference layout
@@ -342,9 +343,21 @@ def _door_segment(
     if not lines:
         return None
     merged = shapely.line_merge(unary_union(lines))
-    candidates = list(shapely.get_parts(merged))
+    # straight pieces only: a segment spanning a bend would cut the corner, off the shared wall
+    pieces = [
+        LineString(pair)
+        for part in shapely.get_parts(merged)
+        for pair in zip(part.coords[:-1], part.coords[1:], strict=True)
+        if math.dist(*pair) > 0
+    ]
+    if not pieces:
+        return None
+    # the piece most of the touching points are nearest to (then the one nearest their centre)
     centre = Point(points.mean(axis=0))
-    line = min(candidates, key=lambda g: g.distance(centre))
+    nearest = [min(range(len(pieces)), key=lambda i: pieces[i].distance(Point(p))) for p in points]
+    line = pieces[
+        max(range(len(pieces)), key=lambda i: (nearest.count(i), -pieces[i].distance(centre)))
+    ]
     ts = [line.project(Point(p)) for p in points]
     t0, t1 = max(0.0, min(ts) - res / 2.0), min(line.length, max(ts) + res / 2.0)
     if t1 - t0 <= 0:
