@@ -402,8 +402,10 @@ def annotate(
     ] = None,
     door_width: Annotated[
         float,
-        typer.Option("--door-width", callback=check_finite, help="--auto: widest door opening, m."),
-    ] = 1.0,
+        typer.Option(
+            "--door-width", callback=check_finite, help="--auto: widest door or opening, m."
+        ),
+    ] = RoomParams().door_width,
     min_room_area: Annotated[
         float,
         typer.Option("--min-room-area", callback=check_finite, help="--auto: smallest room, m²."),

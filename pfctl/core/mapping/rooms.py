@@ -1,32 +1,43 @@
 """Automatic room segmentation of an occupancy map's free space, and door proposals.
 
-Distance-transform segmentation after Bormann et al. (2016), "Room segmentation: survey,
-implementation, and analysis" (§III-B there), with a watershed growth step:
+A door is an opening in a wall line between two spaces; a gap between two free-standing objects
+inside one space is not. The default method (``method="walls"``) closes every opening of a wall
+line and takes what the free space falls apart into as rooms; the distance-transform method of
+Bormann et al. (2016), "Room segmentation: survey, implementation, and analysis" (§III-B there),
+is kept as ``method="distance"`` (it cuts at every narrow place, furniture gaps included, and
+cannot tell a 1.2 m corridor from a 1.4 m door). Both share the watershed growth step:
 
 0. **Clean-up.** Non-free specks smaller than ``noise_area`` inside the free space (laser
    noise, unknown pinholes of a SLAM map) count as free.
-1. **Cores.** The Euclidean distance transform of the free space gives, per free cell, the
-   distance to the nearest non-free cell. Keeping the cells farther than ``core_radius`` from any
-   obstacle cuts the free space at every opening narrower than ``2·core_radius`` — doors — while
-   rooms and corridors wider than that keep a core. ``core_radius`` defaults to half the widest
-   door plus one cell (``door_width/2 + resolution``), so it must stay below half the narrowest
-   room or corridor (a 2 m hall has 1.9 m of free width: fine up to ``door_width ≈ 1.7``).
-   Connected cores (4-connectivity) smaller than ``min_core_area`` are dropped (nooks behind
-   furniture).
-2. **Growth.** The cores are grown back over all free cells by a priority flood on the distance
+1. **Cores.**
+   - ``walls``: per row (and per column), a run of non-occupied cells between
+     ``min_door_width`` and ``door_width`` long is an opening if both its ends are *jambs*: a
+     straight run of at least ``jamb_length`` of occupied cells continuing the row, at most
+     ``wall_thickness`` thick across where it meets the opening. A wall seen end-on (the side
+     wall of a corridor, crossed) is too short along the row; the side of a piece of furniture,
+     or a wall with a wardrobe against it, is too thick across. The openings' cells are taken out
+     of the free space; its connected parts (4-connectivity) are the cores.
+   - ``distance``: the Euclidean distance transform of the free space; the cells farther than
+     ``core_radius`` (default ``door_width/2 + resolution``) from any obstacle, so the free space
+     is cut at every passage narrower than ``2·core_radius``.
+
+   Cores smaller than ``min_core_area`` are dropped (nooks behind furniture).
+2. **Growth.** The cores are grown back over the free cells by a priority flood on the distance
    transform (a watershed: the cell with the largest bottleneck distance to a core goes first),
-   so two rooms meet at the narrowest place between them — inside the door opening — and never
-   through a wall. Rooms smaller than ``min_room_area`` are merged into the neighbour they share
-   most free border with. Then each occupied cell (wall, furniture) connected to a room takes
-   the label of the nearest room cell, so a wall between two rooms is split down its middle
-   line; enclosed unlabelled cells join the room around them; unknown cells outside stay
-   unlabelled.
+   so two rooms meet at the narrowest place between them and never through a wall; with
+   ``walls``, an opening's cells are split last, each to the nearest room, so rooms meet on the
+   opening's middle line. Rooms smaller than ``min_room_area`` are merged into the neighbour they
+   share most free border with. Then each occupied cell (wall, furniture) connected to a room
+   takes the label of the nearest room cell, so a wall between two rooms is split down its middle
+   line; unlabelled cells the rooms enclose (furniture, unknown patches, one in a doorway) take
+   the label of the nearest room cell; unknown cells outside stay unlabelled.
 3. **Polygons.** Each room's label mask is vectorised along the cell edges, its holes (furniture)
    filled, and the rooms simplified together as a coverage (``shapely.coverage_simplify``), so
    neighbouring rooms keep sharing exactly the same edge.
-4. **Doors.** Wherever two rooms' free cells touch, a door is proposed: the part of their shared
-   polygon edge that spans the touching cells, on one straight piece of it (the piece most of
-   them are nearest to), so the door lies on the wall the two polygons share.
+4. **Doors.** Wherever two rooms touch (``walls``: in an opening, free or unknown cells there;
+   ``distance``: in free space), a door is proposed: the part of their shared polygon edge that
+   spans the touching cells, on one straight piece of it (the piece most of them are nearest
+   to); its ends are added to both rooms' outlines, so the door lies exactly on their wall.
 
 Rooms are named ``room_1``, ``room_2``, … by their centroid, south to north then west to east
 (rows of ``name_row_height`` metres), or after the best-matching region of a reference layout
@@ -61,7 +72,13 @@ class RoomParams:
     """Parameters of :func:`segment_rooms` (metres and square metres).
 
     Attributes:
-        door_width: the widest door opening to cut at. Default 1.0 m (doors are ~0.8–1.0 m).
+        door_width: the widest door or opening to cut at (3.2 m: doors are ~0.8–1.4 m, the
+            opening between a living room and a kitchen up to 3 m).
+        method: ``walls`` (openings in wall lines) or ``distance`` (distance transform); see the
+            module docstring.
+        jamb_length: ``walls``: how far a wall line must continue past an opening (0.2 m).
+        wall_thickness: ``walls``: the thickest a wall line may be where it meets an opening
+            (0.2 m; furniture is 0.3 m deep or more).
         core_radius: the distance-transform threshold of step 1; ``None`` means
             ``door_width/2 + resolution``. Must be below half the narrowest room or corridor.
         min_core_area: cores smaller than this are dropped before growing (0.5 m²).
@@ -77,7 +94,10 @@ class RoomParams:
         name_row_height: centroid rows for the deterministic ``room_N`` order (1.0 m).
     """
 
-    door_width: float = 1.0
+    door_width: float = 3.2
+    method: str = "walls"
+    jamb_length: float = 0.2
+    wall_thickness: float = 0.2
     core_radius: float | None = None
     min_core_area: float = 0.5
     min_room_area: float = 2.0
@@ -164,6 +184,79 @@ def _cores(free: NDArray[np.bool_], dist: NDArray[np.float64], radius: float, mi
     for new, old in enumerate(kept, start=1):
         keep[old] = new
     return keep[cores]
+
+
+def _runs_across(occupied: NDArray[np.bool_]) -> NDArray[np.int32]:
+    """Per occupied cell, the length of the vertical run of occupied cells through it; 0 else."""
+    h = occupied.shape[0]
+    up = np.zeros(occupied.shape, dtype=np.int32)
+    down = np.zeros(occupied.shape, dtype=np.int32)
+    occ = occupied.astype(np.int32)
+    up[0] = occ[0]
+    for r in range(1, h):
+        up[r] = (up[r - 1] + 1) * occ[r]
+    down[h - 1] = occ[h - 1]
+    for r in range(h - 2, -1, -1):
+        down[r] = (down[r + 1] + 1) * occ[r]
+    return np.where(occupied, up + down - 1, 0).astype(np.int32)
+
+
+def _row_gaps(
+    occupied: NDArray[np.bool_],
+    gap_cells: tuple[int, int],
+    jamb_cells: int,
+    thin_cells: int,
+) -> NDArray[np.bool_]:
+    """Openings in horizontal wall lines: per row, a run of non-occupied cells ``gap_cells``
+    (lowest, highest) long between two jambs, each a straight run of at least ``jamb_cells``
+    occupied cells in the same row whose first two cells are at most ``thin_cells`` thick
+    across (a wall, not the side of a piece of furniture, nor a wall seen end-on)."""
+    h, w = occupied.shape
+    across = _runs_across(occupied)
+    occ = occupied.astype(np.int32)
+    left = np.zeros(occupied.shape, dtype=np.int32)  # occupied run ending here, from the west
+    right = np.zeros(occupied.shape, dtype=np.int32)  # occupied run starting here, to the east
+    left[:, 0] = occ[:, 0]
+    for c in range(1, w):
+        left[:, c] = (left[:, c - 1] + 1) * occ[:, c]
+    right[:, w - 1] = occ[:, w - 1]
+    for c in range(w - 2, -1, -1):
+        right[:, c] = (right[:, c + 1] + 1) * occ[:, c]
+    thin = occupied & (across <= thin_cells)
+    out = np.zeros(occupied.shape, dtype=bool)
+    lo, hi = gap_cells
+    for r in range(h):
+        row = occupied[r]
+        edges = np.flatnonzero(np.diff(row.astype(np.int8)))
+        # a gap starts after an occupied cell (edge at c0-1) and ends before one (edge at c1)
+        starts = [int(e) + 1 for e in edges if row[e]]
+        ends = [int(e) for e in edges if not row[e]]
+        for c0 in starts:
+            c1 = next((e for e in ends if e >= c0), None)
+            if c1 is None or not lo <= c1 - c0 + 1 <= hi:
+                continue
+            a, b = c0 - 1, c1 + 1
+            if left[r, a] < jamb_cells or right[r, b] < jamb_cells:
+                continue
+            if a < 1 or b > w - 2:
+                continue
+            if thin[r, a] and thin[r, a - 1] and thin[r, b] and thin[r, b + 1]:
+                out[r, c0 : c1 + 1] = True
+    return out
+
+
+def _wall_openings(
+    occupied: NDArray[np.bool_], res: float, params: RoomParams
+) -> NDArray[np.bool_]:
+    """The cells of every opening in a wall line, horizontal or vertical (see :func:`_row_gaps`):
+    doors and wide openings between two spaces, which the segmentation closes to find rooms."""
+    gap = (
+        max(1, math.ceil(params.min_door_width / res)),
+        max(1, math.floor(params.door_width / res)),
+    )
+    jamb = max(2, round(params.jamb_length / res))
+    thin = max(1, round(params.wall_thickness / res))
+    return _row_gaps(occupied, gap, jamb, thin) | _row_gaps(occupied.T, gap, jamb, thin).T
 
 
 def _despeckle(free: NDArray[np.bool_], max_cells: int) -> NDArray[np.bool_]:
@@ -271,11 +364,15 @@ def _merge_small(labels: NDArray[np.int32], min_cells: int) -> NDArray[np.int32]
 
 
 def _fill_holes(labels: NDArray[np.int32]) -> NDArray[np.int32]:
-    """Give each room the unlabelled cells it encloses (furniture islands, unknown pockets)."""
+    """Give the unlabelled cells the rooms enclose (furniture islands, unknown pockets, also one
+    in a doorway between two rooms) the label of the nearest room cell."""
+    rooms = labels > 0
+    holes = ndimage.binary_fill_holes(rooms) & ~rooms
+    if not holes.any():
+        return labels
+    _, (ir, ic) = ndimage.distance_transform_edt(~rooms, return_indices=True)
     out = labels.copy()
-    for lab in np.unique(labels[labels > 0]).tolist():
-        filled = ndimage.binary_fill_holes(labels == lab)
-        out[filled & (out == 0)] = lab
+    out[holes] = labels[ir[holes], ic[holes]]
     return out
 
 
@@ -333,6 +430,22 @@ def _ring(poly: Polygon, res: float) -> tuple[XY, ...]:
     pts = [(round(x, digits) + 0.0, round(y, digits) + 0.0) for x, y in ring]
     start = min(range(len(pts)), key=lambda i: (pts[i][1], pts[i][0]))
     return tuple(pts[start:] + pts[:start])
+
+
+def _with_vertices(ring: tuple[XY, ...], points: tuple[XY, XY], res: float) -> tuple[XY, ...]:
+    """``ring`` with each of ``points`` inserted as a vertex on the edge it lies on (within a
+    cell), unless it is a vertex already: a rounded door end on a slanted edge is then exactly on
+    the outline of both rooms it joins."""
+    out = list(ring)
+    for p in points:
+        if p in out:
+            continue
+        n = len(out)
+        dists = [LineString([out[i], out[(i + 1) % n]]).distance(Point(p)) for i in range(n)]
+        i = min(range(n), key=dists.__getitem__)
+        if dists[i] <= res:
+            out.insert(i + 1, p)
+    return tuple(out)
 
 
 def _door_segment(
@@ -457,12 +570,27 @@ def segment_free_space(
     cell_area = res * res
 
     dist = ndimage.distance_transform_edt(free) * res
-    cores = _cores(free, dist, radius, max(1, math.ceil(params.min_core_area / cell_area)))
+    min_core = max(1, math.ceil(params.min_core_area / cell_area))
+    if params.method not in ("walls", "distance"):
+        raise ValueError(f"expected method 'walls' or 'distance', got {params.method!r}")
+    if params.method == "walls":
+        gaps = _wall_openings(occupied, res, params)
+        openings = gaps & free
+        cores = _cores(free & ~openings, dist, 0.0, min_core)
+        # rooms first grow over their own free space, then split each opening down its middle
+        labels = _watershed(cores, free & ~openings, dist)
+        labels = _grow_into(labels, openings, math.inf)
+        # doors are where rooms touch in an opening (free or unknown cells there)
+        door_cells = ndimage.binary_dilation(gaps, structure=_EIGHT) & ~occupied
+    else:
+        cores = _cores(free, dist, radius, min_core)
+        labels = cores
+        door_cells = free
     if cores.max() == 0:
         raise ValueError(
             f"no room found: no free space farther than {radius:.2f} m from an obstacle"
         )
-    labels = _watershed(cores, free, dist)
+    labels = _watershed(labels, free, dist)
     labels = _merge_small(labels, max(1, math.ceil(params.min_room_area / cell_area)))
     reach = math.inf if params.wall_reach is None else params.wall_reach / res
     labels = _grow_into(labels, occupied, reach)
@@ -475,21 +603,23 @@ def segment_free_space(
     polygons = _label_polygons(labels, geometry, tolerance)
     order = _order(polygons, params.name_row_height)
     names = {lab: f"room_{i}" for i, lab in enumerate(order, start=1)}
+    found = _doors(labels, door_cells, geometry, polygons, params.min_door_width)
+    rings = {lab: _ring(polygons[lab], res) for lab in order}
+    for (a, b), seg in found:  # door ends as vertices of both rooms: exactly on their wall
+        rings[a] = _with_vertices(rings[a], seg, res)
+        rings[b] = _with_vertices(rings[b], seg, res)
     rooms = tuple(
         ProposedRoom(
             label=lab,
             name=names[lab],
-            polygon=_ring(polygons[lab], res),
+            polygon=rings[lab],
             area=round(float(polygons[lab].area), 3),
         )
         for lab in order
     )
     doors = tuple(
         sorted(
-            (
-                ProposedDoor(between=(names[a], names[b]), segment=seg)
-                for (a, b), seg in _doors(labels, free, geometry, polygons, params.min_door_width)
-            ),
+            (ProposedDoor(between=(names[a], names[b]), segment=seg) for (a, b), seg in found),
             key=lambda d: (d.between, d.segment),
         )
     )
