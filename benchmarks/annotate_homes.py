@@ -55,6 +55,7 @@ class Score:
     doors: int
     doors_found: int
     proposed_doors: int
+    iou_sum: float = 0.0
     failed: str = ""
     warnings: int = 0
 
@@ -88,6 +89,7 @@ def score(truth: HouseLayout, proposal: HouseLayout) -> Score:
         doors=len(truth.doors),
         doors_found=found,
         proposed_doors=len(proposal.doors),
+        iou_sum=sum(iou for _, iou in matched.values()),
     )
 
 
@@ -166,6 +168,7 @@ def main(argv: list[str] | None = None) -> int:
             for name in ("regions", "rooms_matched", "proposed_rooms", "doors", "doors_found"):
                 setattr(total, name, getattr(total, name) + getattr(s, name))
             total.proposed_doors += s.proposed_doors
+            total.iou_sum += s.iou_sum
             failures += bool(s.failed)
             warned += bool(s.warnings)
             if s.failed or s.rooms_matched < s.regions or s.doors_found < s.doors or s.spurious:
@@ -181,10 +184,14 @@ def main(argv: list[str] | None = None) -> int:
         f"noise {'on' if args.noise else 'off'}, door_width {params.door_width:g} m, "
         f"{time.monotonic() - t0:.0f} s"
     )
-    print("| rooms IoU≥0.7 | doors found | spurious doors | failures (exit 2) | homes warned |")
-    print("|---|---|---|---|---|")
+    print(
+        "| rooms IoU≥0.7 | mean IoU of those | doors found | spurious doors "
+        "| failures (exit 2) | homes warned |"
+    )
+    print("|---|---|---|---|---|---|")
     print(
         f"| {_pct(total.rooms_matched, total.regions)} % ({total.rooms_matched}/{total.regions}) "
+        f"| {total.iou_sum / max(1, total.rooms_matched):.3f} "
         f"| {_pct(total.doors_found, total.doors)} % ({total.doors_found}/{total.doors}) "
         f"| {_pct(total.spurious, total.proposed_doors)} % "
         f"({total.spurious}/{total.proposed_doors}) | {failures} | {warned} |"

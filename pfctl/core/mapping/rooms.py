@@ -27,8 +27,10 @@ cannot tell a 1.2 m corridor from a 1.4 m door). Both share the watershed growth
    so two rooms meet at the narrowest place between them and never through a wall; with
    ``walls``, an opening's cells are split last, each to the nearest room, so rooms meet on the
    opening's middle line. Rooms smaller than ``min_room_area`` are merged into the neighbour they
-   share most free border with. Then each occupied cell (wall, furniture) connected to a room
-   takes the label of the nearest room cell, so a wall between two rooms is split down its middle
+   share most free border with. With ``walls``, each piece of furniture (an occupied blob thick
+   enough to hold a square ``wall_thickness`` + one cell wide) goes whole to the room it borders
+   most. Then each occupied cell (wall, furniture) connected to a room takes the label of the
+   nearest room cell, so a wall between two rooms is split down its middle
    line; unlabelled cells the rooms enclose (furniture, unknown patches, one in a doorway) take
    the label of the nearest room cell; unknown cells outside stay unlabelled.
 3. **Polygons.** Each room's label mask is vectorised along the cell edges, its holes (furniture)
@@ -259,6 +261,12 @@ def _wall_openings(
     return _row_gaps(occupied, gap, jamb, thin) | _row_gaps(occupied.T, gap, jamb, thin).T
 
 
+def _furniture(occupied: NDArray[np.bool_], thick_cells: int) -> NDArray[np.bool_]:
+    """The occupied cells of blobs thick enough to hold a ``thick_cells`` square: furniture (walls
+    are thinner)."""
+    return ndimage.binary_opening(occupied, structure=np.ones((thick_cells, thick_cells), bool))
+
+
 def _despeckle(free: NDArray[np.bool_], max_cells: int) -> NDArray[np.bool_]:
     """Free space with every non-free blob of at most ``max_cells`` cells (8-connected) inside it
     counted as free: laser speckle and unknown pinholes of a mapped room, not walls."""
@@ -320,6 +328,29 @@ def _grow_into(
     take = allowed & connected & (labels == 0) & (dist <= reach_cells)
     out = labels.copy()
     out[take] = labels[ir[take], ic[take]]
+    return out
+
+
+def _furniture_to_rooms(
+    labels: NDArray[np.int32], occupied: NDArray[np.bool_], thick_cells: int
+) -> NDArray[np.int32]:
+    """Give each thick occupied blob (furniture: it holds a ``thick_cells`` square, a wall does
+    not) wholly to the room it borders most, so a wardrobe against a wall stays in its room
+    instead of being split with the room behind the wall."""
+    blobs, n = ndimage.label(_furniture(occupied, thick_cells), structure=_EIGHT)
+    if n == 0:
+        return labels
+    out = labels.copy()
+    for k, sl in enumerate(ndimage.find_objects(blobs), start=1):
+        if sl is None:
+            continue
+        grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in sl)
+        blob = blobs[grown] == k
+        ring = ndimage.binary_dilation(blob, structure=_FOUR) & ~blob
+        around = labels[grown][ring]
+        around = around[around > 0]
+        if around.size:
+            out[grown][blob] = np.bincount(around).argmax()
     return out
 
 
@@ -597,6 +628,10 @@ def segment_free_space(
     labels = _watershed(labels, free, dist)
     labels = _merge_small(labels, max(1, math.ceil(params.min_room_area / cell_area)))
     reach = math.inf if params.wall_reach is None else params.wall_reach / res
+    if params.method == "walls":
+        labels = _furniture_to_rooms(
+            labels, occupied, max(2, round(params.wall_thickness / res) + 1)
+        )
     labels = _grow_into(labels, occupied, reach)
     labels = _fill_holes(labels)
     labels = _relabel(labels)

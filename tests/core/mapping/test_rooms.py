@@ -237,3 +237,17 @@ def test_an_unknown_method_is_an_error() -> None:
     grid = rasterize_house(_two_rooms(0.9), 0.1)
     with pytest.raises(ValueError, match="expected method"):
         segment_rooms(grid, RoomParams(method="voronoi"))
+
+
+def test_a_wardrobe_against_a_shared_wall_stays_in_its_room() -> None:
+    """Furniture is given whole to the room it stands in, not split with the room behind."""
+    layout = _two_rooms(0.9)
+    wardrobe = Obstacle(
+        name="wardrobe", polygon=((4.05, 2.2), (4.65, 2.2), (4.65, 2.95), (4.05, 2.95))
+    )
+    grid = rasterize_house(HouseLayout(layout.regions, layout.doors, (wardrobe,)), 0.05)
+    seg = segment_rooms(grid)
+    a, b = (Polygon(r.polygon) for r in seg.rooms)
+    centre = Polygon(wardrobe.polygon).centroid
+    assert b.contains(centre) and not a.contains(centre)
+    assert polygon_iou(a, Polygon(layout.regions[0].polygon)) > 0.95
