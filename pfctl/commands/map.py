@@ -17,6 +17,7 @@ from __future__ import annotations
 import io
 import math
 import re
+import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -29,9 +30,9 @@ from rich.table import Table
 from shapely.geometry import Polygon
 
 from pfctl.commands import check_finite
-from pfctl.core.mapping.grid import OccupancyGrid
+from pfctl.core.mapping.grid import GridGeometry, OccupancyGrid
 from pfctl.core.mapping.house import Door, HouseLayout, Region
-from pfctl.core.mapping.rooms import RoomParams, name_after, segment_rooms
+from pfctl.core.mapping.rooms import RoomParams, name_after, segment_free_space
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import MissionError, UserError
 from pfctl.files import check_output_file, write_output
@@ -261,6 +262,45 @@ def check_layout(regions: Sequence[Region], doors: Sequence[Door], resolution: f
         raise UserError(f"regions/doors to annotate: {message}") from None
 
 
+def auto_layout(
+    states: Any,
+    geometry: GridGeometry,
+    params: RoomParams,
+    reference: HouseLayout | None = None,
+) -> tuple[HouseLayout, list[str]]:
+    """The rooms and doors ``--auto`` proposes for a trinary map, and the warnings to print.
+
+    Rooms take the names of ``reference``'s regions they match. UserError if no room is found.
+    """
+    try:
+        seg = segment_free_space(states, geometry, params)
+    except ValueError as err:
+        raise UserError(str(err)) from None
+    if reference is not None:
+        seg = name_after(seg, reference)
+    layout = seg.layout()
+    try:
+        check_layout(layout.regions, layout.doors, geometry.resolution)
+        return layout, []
+    except UserError:
+        pass
+    # a proposed door the mission rules reject is dropped, not the whole proposal
+    check_layout(layout.regions, (), geometry.resolution)
+    kept: list[Door] = []
+    dropped: list[str] = []
+    for d in layout.doors:
+        try:
+            check_layout(layout.regions, (d,), geometry.resolution)
+            kept.append(d)
+        except UserError:
+            dropped.append(f"{d.between[0]}|{d.between[1]}")
+    warnings = [
+        f"--auto: dropped {len(dropped)} proposed door(s) not on the wall their rooms share: "
+        + ", ".join(dropped)
+    ]
+    return HouseLayout(regions=layout.regions, doors=tuple(kept)), warnings
+
+
 # --------------------------------------------------------------------------------------------
 # output
 
@@ -362,8 +402,10 @@ def annotate(
     ] = None,
     door_width: Annotated[
         float,
-        typer.Option("--door-width", callback=check_finite, help="--auto: widest door opening, m."),
-    ] = 1.0,
+        typer.Option(
+            "--door-width", callback=check_finite, help="--auto: widest door or opening, m."
+        ),
+    ] = RoomParams().door_width,
     min_room_area: Annotated[
         float,
         typer.Option("--min-room-area", callback=check_finite, help="--auto: smallest room, m²."),
@@ -395,15 +437,14 @@ def annotate(
     layers: list[tuple[Sequence[Region], Sequence[Door]]] = []
     if auto:
         params = RoomParams(door_width=door_width, min_room_area=min_room_area)
-        try:
-            seg = segment_rooms(grid, params)
-        except ValueError as err:
-            raise UserError(f"{source}: --auto: {err}") from None
         ref_layout = _reference_layout(reference, src, out)
-        if ref_layout is not None:
-            seg = name_after(seg, ref_layout)
-        auto_layout = seg.layout()
-        layers.append((auto_layout.regions, auto_layout.doors))
+        try:
+            proposal, warnings = auto_layout(grid.states(), grid.geometry, params, ref_layout)
+        except UserError as err:
+            raise UserError(f"{source}: --auto: {err}") from None
+        for warning in warnings:
+            sys.stderr.write(f"pfctl: warning: {source}: {warning}\n")
+        layers.append((proposal.regions, proposal.doors))
     if regions_file is not None:
         layers.append(file_layer)
     if flag_regions or flag_doors:

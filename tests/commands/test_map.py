@@ -7,6 +7,7 @@ import shutil
 import struct
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -317,3 +318,31 @@ def test_write_regions_creates_a_minimal_mission(tmp_path) -> None:
     assert "doors: []" in text
     assert load_mission(target).map.regions[0].name == "r"
     assert oct(os.stat(target).st_mode & 0o777) != "0o600"  # a normal file, not a temp file's mode
+
+
+def test_auto_drops_a_door_off_the_shared_wall_with_one_warning(
+    monkeypatch, capsys, house_map, tmp_path
+) -> None:
+    """A proposed door the mission rules reject is dropped with one warning; exit 0, written."""
+    import pfctl.commands.map as map_command
+    from pfctl.core.mapping.rooms import ProposedDoor
+
+    real = map_command.segment_free_space
+
+    def with_a_corner_cutting_door(states, geometry, params):
+        seg = real(states, geometry, params)
+        bad = ProposedDoor(between=seg.doors[0].between, segment=((0.5, 0.5), (1.5, 1.7)))
+        return replace(seg, doors=(*seg.doors, bad))
+
+    monkeypatch.setattr(map_command, "segment_free_space", with_a_corner_cutting_door)
+    out = tmp_path / "m.yaml"
+    code, stdout, err = cli(
+        monkeypatch, capsys, "map", "annotate", house_map, "--auto", "--out", out
+    )
+    assert code == 0, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("pfctl: warning: "), err
+    assert "dropped 1 proposed door" in lines[0]
+    written = load_mission(out).layout()
+    assert len(written.regions) == 5 and len(written.doors) == 5
+    assert "wrote" in stdout

@@ -1,31 +1,45 @@
 """Automatic room segmentation of an occupancy map's free space, and door proposals.
 
-Distance-transform segmentation after Bormann et al. (2016), "Room segmentation: survey,
-implementation, and analysis" (§III-B there), with a watershed growth step:
+A door is an opening in a wall line between two spaces; a gap between two free-standing objects
+inside one space is not. The default method (``method="walls"``) closes every opening of a wall
+line and takes what the free space falls apart into as rooms; the distance-transform method of
+Bormann et al. (2016), "Room segmentation: survey, implementation, and analysis" (§III-B there),
+is kept as ``method="distance"`` (it cuts at every narrow place, furniture gaps included, and
+cannot tell a 1.2 m corridor from a 1.4 m door). Both share the watershed growth step:
 
 0. **Clean-up.** Non-free specks smaller than ``noise_area`` inside the free space (laser
    noise, unknown pinholes of a SLAM map) count as free.
-1. **Cores.** The Euclidean distance transform of the free space gives, per free cell, the
-   distance to the nearest non-free cell. Keeping the cells farther than ``core_radius`` from any
-   obstacle cuts the free space at every opening narrower than ``2·core_radius`` — doors — while
-   rooms and corridors wider than that keep a core. ``core_radius`` defaults to half the widest
-   door plus one cell (``door_width/2 + resolution``), so it must stay below half the narrowest
-   room or corridor (a 2 m hall has 1.9 m of free width: fine up to ``door_width ≈ 1.7``).
-   Connected cores (4-connectivity) smaller than ``min_core_area`` are dropped (nooks behind
-   furniture).
-2. **Growth.** The cores are grown back over all free cells by a priority flood on the distance
+1. **Cores.**
+   - ``walls``: per row (and per column), a run of non-occupied cells between
+     ``min_door_width`` and ``door_width`` long is an opening if both its ends are *jambs*: a
+     straight run of at least ``jamb_length`` of occupied cells continuing the row, at most
+     ``wall_thickness`` thick across where it meets the opening. A wall seen end-on (the side
+     wall of a corridor, crossed) is too short along the row; the side of a piece of furniture,
+     or a wall with a wardrobe against it, is too thick across. The openings' cells are taken out
+     of the free space; its connected parts (4-connectivity) are the cores.
+   - ``distance``: the Euclidean distance transform of the free space; the cells farther than
+     ``core_radius`` (default ``door_width/2 + resolution``) from any obstacle, so the free space
+     is cut at every passage narrower than ``2·core_radius``.
+
+   Cores smaller than ``min_core_area`` are dropped (nooks behind furniture).
+2. **Growth.** The cores are grown back over the free cells by a priority flood on the distance
    transform (a watershed: the cell with the largest bottleneck distance to a core goes first),
-   so two rooms meet at the narrowest place between them — inside the door opening — and never
-   through a wall. Rooms smaller than ``min_room_area`` are merged into the neighbour they share
-   most free border with. Then each occupied cell (wall, furniture) connected to a room takes
-   the label of the nearest room cell, so a wall between two rooms is split down its middle
-   line; enclosed unlabelled cells join the room around them; unknown cells outside stay
-   unlabelled.
+   so two rooms meet at the narrowest place between them and never through a wall; with
+   ``walls``, an opening's cells are split last, each to the nearest room, so rooms meet on the
+   opening's middle line. Rooms smaller than ``min_room_area`` are merged into the neighbour they
+   share most free border with. With ``walls``, each piece of furniture (an occupied blob thick
+   enough to hold a square ``wall_thickness`` + one cell wide) goes whole to the room it borders
+   most. Then each occupied cell (wall, furniture) connected to a room takes the label of the
+   nearest room cell, so a wall between two rooms is split down its middle
+   line; unlabelled cells the rooms enclose (furniture, unknown patches, one in a doorway) take
+   the label of the nearest room cell; unknown cells outside stay unlabelled.
 3. **Polygons.** Each room's label mask is vectorised along the cell edges, its holes (furniture)
    filled, and the rooms simplified together as a coverage (``shapely.coverage_simplify``), so
    neighbouring rooms keep sharing exactly the same edge.
-4. **Doors.** Wherever two rooms' free cells touch, a door is proposed: the part of their shared
-   polygon edge that spans the touching cells.
+4. **Doors.** Wherever two rooms touch (``walls``: in an opening, free or unknown cells there;
+   ``distance``: in free space), a door is proposed: the part of their shared polygon edge that
+   spans the touching cells, on one straight piece of it (the piece most of them are nearest
+   to); its ends are added to both rooms' outlines, so the door lies exactly on their wall.
 
 Rooms are named ``room_1``, ``room_2``, … by their centroid, south to north then west to east
 (rows of ``name_row_height`` metres), or after the best-matching region of a reference layout
@@ -60,7 +74,13 @@ class RoomParams:
     """Parameters of :func:`segment_rooms` (metres and square metres).
 
     Attributes:
-        door_width: the widest door opening to cut at. Default 1.0 m (doors are ~0.8–1.0 m).
+        door_width: the widest door or opening to cut at (3.2 m: doors are ~0.8–1.4 m, the
+            opening between a living room and a kitchen up to 3 m).
+        method: ``walls`` (openings in wall lines) or ``distance`` (distance transform); see the
+            module docstring.
+        jamb_length: ``walls``: how far a wall line must continue past an opening (0.2 m).
+        wall_thickness: ``walls``: the thickest a wall line may be where it meets an opening
+            (0.2 m; furniture is 0.3 m deep or more).
         core_radius: the distance-transform threshold of step 1; ``None`` means
             ``door_width/2 + resolution``. Must be below half the narrowest room or corridor.
         min_core_area: cores smaller than this are dropped before growing (0.5 m²).
@@ -76,7 +96,10 @@ class RoomParams:
         name_row_height: centroid rows for the deterministic ``room_N`` order (1.0 m).
     """
 
-    door_width: float = 1.0
+    door_width: float = 3.2
+    method: str = "walls"
+    jamb_length: float = 0.2
+    wall_thickness: float = 0.2
     core_radius: float | None = None
     min_core_area: float = 0.5
     min_room_area: float = 2.0
@@ -165,6 +188,85 @@ def _cores(free: NDArray[np.bool_], dist: NDArray[np.float64], radius: float, mi
     return keep[cores]
 
 
+def _runs_across(occupied: NDArray[np.bool_]) -> NDArray[np.int32]:
+    """Per occupied cell, the length of the vertical run of occupied cells through it; 0 else."""
+    h = occupied.shape[0]
+    up = np.zeros(occupied.shape, dtype=np.int32)
+    down = np.zeros(occupied.shape, dtype=np.int32)
+    occ = occupied.astype(np.int32)
+    up[0] = occ[0]
+    for r in range(1, h):
+        up[r] = (up[r - 1] + 1) * occ[r]
+    down[h - 1] = occ[h - 1]
+    for r in range(h - 2, -1, -1):
+        down[r] = (down[r + 1] + 1) * occ[r]
+    return np.where(occupied, up + down - 1, 0).astype(np.int32)
+
+
+def _row_gaps(
+    occupied: NDArray[np.bool_],
+    gap_cells: tuple[int, int],
+    jamb_cells: int,
+    thin_cells: int,
+) -> NDArray[np.bool_]:
+    """Openings in horizontal wall lines: per row, a run of non-occupied cells ``gap_cells``
+    (lowest, highest) long between two jambs, each a straight run of at least ``jamb_cells``
+    occupied cells in the same row whose first two cells are at most ``thin_cells`` thick
+    across (a wall, not the side of a piece of furniture, nor a wall seen end-on)."""
+    h, w = occupied.shape
+    across = _runs_across(occupied)
+    occ = occupied.astype(np.int32)
+    left = np.zeros(occupied.shape, dtype=np.int32)  # occupied run ending here, from the west
+    right = np.zeros(occupied.shape, dtype=np.int32)  # occupied run starting here, to the east
+    left[:, 0] = occ[:, 0]
+    for c in range(1, w):
+        left[:, c] = (left[:, c - 1] + 1) * occ[:, c]
+    right[:, w - 1] = occ[:, w - 1]
+    for c in range(w - 2, -1, -1):
+        right[:, c] = (right[:, c + 1] + 1) * occ[:, c]
+    thin = occupied & (across <= thin_cells)
+    out = np.zeros(occupied.shape, dtype=bool)
+    lo, hi = gap_cells
+    for r in range(h):
+        row = occupied[r]
+        edges = np.flatnonzero(np.diff(row.astype(np.int8)))
+        # a gap starts after an occupied cell (edge at c0-1) and ends before one (edge at c1)
+        starts = [int(e) + 1 for e in edges if row[e]]
+        ends = [int(e) for e in edges if not row[e]]
+        for c0 in starts:
+            c1 = next((e for e in ends if e >= c0), None)
+            if c1 is None or not lo <= c1 - c0 + 1 <= hi:
+                continue
+            a, b = c0 - 1, c1 + 1
+            if left[r, a] < jamb_cells or right[r, b] < jamb_cells:
+                continue
+            if a < 1 or b > w - 2:
+                continue
+            if thin[r, a] and thin[r, a - 1] and thin[r, b] and thin[r, b + 1]:
+                out[r, c0 : c1 + 1] = True
+    return out
+
+
+def _wall_openings(
+    occupied: NDArray[np.bool_], res: float, params: RoomParams
+) -> NDArray[np.bool_]:
+    """The cells of every opening in a wall line, horizontal or vertical (see :func:`_row_gaps`):
+    doors and wide openings between two spaces, which the segmentation closes to find rooms."""
+    gap = (
+        max(1, math.ceil(params.min_door_width / res)),
+        max(1, math.floor(params.door_width / res)),
+    )
+    jamb = max(2, round(params.jamb_length / res))
+    thin = max(1, round(params.wall_thickness / res))
+    return _row_gaps(occupied, gap, jamb, thin) | _row_gaps(occupied.T, gap, jamb, thin).T
+
+
+def _furniture(occupied: NDArray[np.bool_], thick_cells: int) -> NDArray[np.bool_]:
+    """The occupied cells of blobs thick enough to hold a ``thick_cells`` square: furniture (walls
+    are thinner)."""
+    return ndimage.binary_opening(occupied, structure=np.ones((thick_cells, thick_cells), bool))
+
+
 def _despeckle(free: NDArray[np.bool_], max_cells: int) -> NDArray[np.bool_]:
     """Free space with every non-free blob of at most ``max_cells`` cells (8-connected) inside it
     counted as free: laser speckle and unknown pinholes of a mapped room, not walls."""
@@ -229,6 +331,29 @@ def _grow_into(
     return out
 
 
+def _furniture_to_rooms(
+    labels: NDArray[np.int32], occupied: NDArray[np.bool_], thick_cells: int
+) -> NDArray[np.int32]:
+    """Give each thick occupied blob (furniture: it holds a ``thick_cells`` square, a wall does
+    not) wholly to the room it borders most, so a wardrobe against a wall stays in its room
+    instead of being split with the room behind the wall."""
+    blobs, n = ndimage.label(_furniture(occupied, thick_cells), structure=_EIGHT)
+    if n == 0:
+        return labels
+    out = labels.copy()
+    for k, sl in enumerate(ndimage.find_objects(blobs), start=1):
+        if sl is None:
+            continue
+        grown = tuple(slice(max(0, s.start - 1), s.stop + 1) for s in sl)
+        blob = blobs[grown] == k
+        ring = ndimage.binary_dilation(blob, structure=_FOUR) & ~blob
+        around = labels[grown][ring]
+        around = around[around > 0]
+        if around.size:
+            out[grown][blob] = np.bincount(around).argmax()
+    return out
+
+
 def _relabel(labels: NDArray[np.int32]) -> NDArray[np.int32]:
     """Renumber the labels present to 1..n in order of first appearance (row-major)."""
     present = [v for v in dict.fromkeys(labels[labels > 0].tolist())]
@@ -270,11 +395,15 @@ def _merge_small(labels: NDArray[np.int32], min_cells: int) -> NDArray[np.int32]
 
 
 def _fill_holes(labels: NDArray[np.int32]) -> NDArray[np.int32]:
-    """Give each room the unlabelled cells it encloses (furniture islands, unknown pockets)."""
+    """Give the unlabelled cells the rooms enclose (furniture islands, unknown pockets, also one
+    in a doorway between two rooms) the label of the nearest room cell."""
+    rooms = labels > 0
+    holes = ndimage.binary_fill_holes(rooms) & ~rooms
+    if not holes.any():
+        return labels
+    _, (ir, ic) = ndimage.distance_transform_edt(~rooms, return_indices=True)
     out = labels.copy()
-    for lab in np.unique(labels[labels > 0]).tolist():
-        filled = ndimage.binary_fill_holes(labels == lab)
-        out[filled & (out == 0)] = lab
+    out[holes] = labels[ir[holes], ic[holes]]
     return out
 
 
@@ -334,6 +463,22 @@ def _ring(poly: Polygon, res: float) -> tuple[XY, ...]:
     return tuple(pts[start:] + pts[:start])
 
 
+def _with_vertices(ring: tuple[XY, ...], points: tuple[XY, XY], res: float) -> tuple[XY, ...]:
+    """``ring`` with each of ``points`` inserted as a vertex on the edge it lies on (within a
+    cell), unless it is a vertex already: a rounded door end on a slanted edge is then exactly on
+    the outline of both rooms it joins."""
+    out = list(ring)
+    for p in points:
+        if p in out:
+            continue
+        n = len(out)
+        dists = [LineString([out[i], out[(i + 1) % n]]).distance(Point(p)) for i in range(n)]
+        i = min(range(n), key=dists.__getitem__)
+        if dists[i] <= res:
+            out.insert(i + 1, p)
+    return tuple(out)
+
+
 def _door_segment(
     shared: BaseGeometry, points: NDArray[np.float64], res: float
 ) -> tuple[XY, XY] | None:
@@ -342,9 +487,21 @@ def _door_segment(
     if not lines:
         return None
     merged = shapely.line_merge(unary_union(lines))
-    candidates = list(shapely.get_parts(merged))
+    # straight pieces only: a segment spanning a bend would cut the corner, off the shared wall
+    pieces = [
+        LineString(pair)
+        for part in shapely.get_parts(merged)
+        for pair in zip(part.coords[:-1], part.coords[1:], strict=True)
+        if math.dist(*pair) > 0
+    ]
+    if not pieces:
+        return None
+    # the piece most of the touching points are nearest to (then the one nearest their centre)
     centre = Point(points.mean(axis=0))
-    line = min(candidates, key=lambda g: g.distance(centre))
+    nearest = [min(range(len(pieces)), key=lambda i: pieces[i].distance(Point(p))) for p in points]
+    line = pieces[
+        max(range(len(pieces)), key=lambda i: (nearest.count(i), -pieces[i].distance(centre)))
+    ]
     ts = [line.project(Point(p)) for p in points]
     t0, t1 = max(0.0, min(ts) - res / 2.0), min(line.length, max(ts) + res / 2.0)
     if t1 - t0 <= 0:
@@ -389,11 +546,15 @@ def _doors(
         if key[0] not in polygons or key[1] not in polygons:
             continue
         pts = np.asarray(pairs[key])
-        # split the contact points into connected stretches (neighbours within 1.5 cells)
+        # split the contact points into stretches: a gap of up to 0.4 m (a speck, a bump, an
+        # unknown patch in the doorway) does not split a door in two
         mask = np.zeros(geometry.shape, dtype=bool)
         rows, cols = geometry.world_to_cell(pts)
         mask[np.clip(rows, 0, geometry.height - 1), np.clip(cols, 0, geometry.width - 1)] = True
-        comp, n = ndimage.label(ndimage.binary_dilation(mask, structure=_EIGHT), _EIGHT)
+        bridge = max(1, math.ceil(0.2 / res))
+        comp, n = ndimage.label(
+            ndimage.binary_dilation(mask, structure=_EIGHT, iterations=bridge), _EIGHT
+        )
         which = comp[np.clip(rows, 0, geometry.height - 1), np.clip(cols, 0, geometry.width - 1)]
         shared = polygons[key[0]].intersection(polygons[key[1]])
         for k in range(1, n + 1):
@@ -444,14 +605,33 @@ def segment_free_space(
     cell_area = res * res
 
     dist = ndimage.distance_transform_edt(free) * res
-    cores = _cores(free, dist, radius, max(1, math.ceil(params.min_core_area / cell_area)))
+    min_core = max(1, math.ceil(params.min_core_area / cell_area))
+    if params.method not in ("walls", "distance"):
+        raise ValueError(f"expected method 'walls' or 'distance', got {params.method!r}")
+    if params.method == "walls":
+        gaps = _wall_openings(occupied, res, params)
+        openings = gaps & free
+        cores = _cores(free & ~openings, dist, 0.0, min_core)
+        # rooms first grow over their own free space, then split each opening down its middle
+        labels = _watershed(cores, free & ~openings, dist)
+        labels = _grow_into(labels, openings, math.inf)
+        # doors are where rooms touch in an opening (free or unknown cells there)
+        door_cells = ndimage.binary_dilation(gaps, structure=_EIGHT) & ~occupied
+    else:
+        cores = _cores(free, dist, radius, min_core)
+        labels = cores
+        door_cells = free
     if cores.max() == 0:
         raise ValueError(
             f"no room found: no free space farther than {radius:.2f} m from an obstacle"
         )
-    labels = _watershed(cores, free, dist)
+    labels = _watershed(labels, free, dist)
     labels = _merge_small(labels, max(1, math.ceil(params.min_room_area / cell_area)))
     reach = math.inf if params.wall_reach is None else params.wall_reach / res
+    if params.method == "walls":
+        labels = _furniture_to_rooms(
+            labels, occupied, max(2, round(params.wall_thickness / res) + 1)
+        )
     labels = _grow_into(labels, occupied, reach)
     labels = _fill_holes(labels)
     labels = _relabel(labels)
@@ -462,21 +642,23 @@ def segment_free_space(
     polygons = _label_polygons(labels, geometry, tolerance)
     order = _order(polygons, params.name_row_height)
     names = {lab: f"room_{i}" for i, lab in enumerate(order, start=1)}
+    found = _doors(labels, door_cells, geometry, polygons, params.min_door_width)
+    rings = {lab: _ring(polygons[lab], res) for lab in order}
+    for (a, b), seg in found:  # door ends as vertices of both rooms: exactly on their wall
+        rings[a] = _with_vertices(rings[a], seg, res)
+        rings[b] = _with_vertices(rings[b], seg, res)
     rooms = tuple(
         ProposedRoom(
             label=lab,
             name=names[lab],
-            polygon=_ring(polygons[lab], res),
+            polygon=rings[lab],
             area=round(float(polygons[lab].area), 3),
         )
         for lab in order
     )
     doors = tuple(
         sorted(
-            (
-                ProposedDoor(between=(names[a], names[b]), segment=seg)
-                for (a, b), seg in _doors(labels, free, geometry, polygons, params.min_door_width)
-            ),
+            (ProposedDoor(between=(names[a], names[b]), segment=seg) for (a, b), seg in found),
             key=lambda d: (d.between, d.segment),
         )
     )

@@ -1,4 +1,5 @@
-"""Automatic room segmentation (distance transform + watershed) and door proposals."""
+"""Automatic room segmentation (wall-line openings or distance transform, watershed) and door
+proposals, on the shipped house, small layouts and generated homes with and without noise."""
 
 from __future__ import annotations
 
@@ -9,8 +10,10 @@ import numpy as np
 import pytest
 from shapely.geometry import LineString, Polygon
 
+from pfctl.core.homes.home import HomeOptions, generate_home
 from pfctl.core.mapping.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
-from pfctl.core.mapping.house import Door, HouseLayout, Region
+from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region
+from pfctl.core.mapping.noise import slam_noise
 from pfctl.core.mapping.rooms import (
     RoomParams,
     match_regions,
@@ -87,12 +90,12 @@ def test_the_labels_cover_free_space_and_walls_but_not_outside(segmentation) -> 
     assert set(np.unique(labels).tolist()) == {0, 1, 2, 3, 4, 5}
 
 
-def _two_rooms(door: float | None) -> HouseLayout:
+def _two_rooms(door: float | None, start: float = 1.0) -> HouseLayout:
     regions = (
         Region("a", ((0, 0), (4, 0), (4, 3), (0, 3))),
         Region("b", ((4, 0), (8, 0), (8, 3), (4, 3))),
     )
-    doors = () if door is None else (Door(("a", "b"), ((4, 1.0), (4, 1.0 + door))),)
+    doors = () if door is None else (Door(("a", "b"), ((4, start), (4, start + door))),)
     return HouseLayout(regions=regions, doors=doors)
 
 
@@ -110,9 +113,10 @@ def test_a_closed_wall_gives_two_rooms_and_no_door() -> None:
 
 
 def test_an_opening_wider_than_door_width_joins_the_rooms() -> None:
-    seg = segment_rooms(rasterize_house(_two_rooms(2.0), 0.05), RoomParams(door_width=1.0))
+    two = rasterize_house(_two_rooms(2.0, start=0.5), 0.05)  # wall on both sides of the opening
+    seg = segment_rooms(two, RoomParams(door_width=1.0))
     assert len(seg.rooms) == 1
-    seg = segment_rooms(rasterize_house(_two_rooms(2.0), 0.05), RoomParams(door_width=2.2))
+    seg = segment_rooms(two, RoomParams(door_width=2.2))
     assert len(seg.rooms) == 2
 
 
@@ -146,3 +150,104 @@ def test_speckle_of_a_mapped_house_does_not_split_rooms(layout, resolution) -> N
     assert len(seg.rooms) == len(layout.regions) and len(seg.doors) == len(layout.doors)
     matches = match_regions(seg.layout().regions, layout.regions, min_iou=0.9)
     assert len(matches) == len(layout.regions)
+
+
+def _generated(seed: int) -> HouseLayout:
+    """The home ``pfctl mission generate --seed SEED`` draws (robot 0.215 m, person 0.25 m)."""
+    home = generate_home(
+        HomeOptions(seed=seed),
+        resolution=0.05,
+        wall_thickness=0.1,
+        robot_radius=0.215,
+        person_radius=0.25,
+    )
+    return home.layout
+
+
+def _doors_found(truth: tuple[Door, ...], proposed: tuple[Door, ...]) -> int:
+    """True doors with a proposed door on them (within 0.25 m, overlapping half the shorter)."""
+    left = list(proposed)
+    found = 0
+    for door in truth:
+        a = LineString(door.segment)
+        for d in left:
+            b = LineString(d.segment)
+            near = a.distance(b) <= 0.25
+            if near and b.intersection(a.buffer(0.25)).length >= 0.5 * min(a.length, b.length):
+                left.remove(d)
+                found += 1
+                break
+    return found
+
+
+@pytest.mark.parametrize("noise", [False, True], ids=["clean", "noisy"])
+@pytest.mark.parametrize("seed", [1, 2, 4, 7])  # corridor, open plan, L-shaped, hall
+def test_a_generated_home_is_segmented_into_its_rooms_and_doors(seed: int, noise: bool) -> None:
+    """The exported map (walls, doors, furniture), with or without SLAM noise: every region
+    matched at IoU ≥ 0.7, at least 90 % of the doors found, at most 5 % spurious (none here)."""
+    truth = _generated(seed)
+    grid = rasterize_house(truth, 0.05, wall_thickness=0.1)
+    states = grid.states()
+    if noise:
+        states = slam_noise(states, 0.05, np.random.default_rng([seed, 25]))
+    seg = segment_free_space(states, grid.geometry)
+    proposal = seg.layout()
+    matches = match_regions(proposal.regions, truth.regions, min_iou=0.7)
+    assert len(matches) == len(truth.regions) == len(proposal.regions)
+    found = _doors_found(truth.doors, proposal.doors)
+    assert found >= 0.9 * len(truth.doors)
+    assert len(proposal.doors) - found == 0
+
+
+def test_a_gap_between_two_pieces_of_furniture_is_not_a_door() -> None:
+    """A sofa and a bookshelf across a room, 1 m apart: one room, no door (the distance method
+    cuts it)."""
+    room = Region("room", ((0, 0), (6, 0), (6, 3), (0, 3)))
+    furniture = (
+        Obstacle(name="sofa", polygon=((2.5, 0.05), (3.4, 0.05), (3.4, 1.0), (2.5, 1.0))),
+        Obstacle(name="shelf", polygon=((2.6, 2.0), (3.0, 2.0), (3.0, 2.95), (2.6, 2.95))),
+    )
+    grid = rasterize_house(HouseLayout(regions=(room,), obstacles=furniture), 0.05)
+    seg = segment_rooms(grid)
+    assert len(seg.rooms) == 1 and seg.doors == ()
+    assert len(segment_rooms(grid, RoomParams(method="distance", door_width=1.0)).rooms) == 2
+
+
+def test_a_corridor_narrower_than_its_doors_is_one_room() -> None:
+    """A 1.2 m corridor with 1.4 m doors to two rooms: three rooms, two doors."""
+    regions = (
+        Region("a", ((0, 0), (4, 0), (4, 3), (0, 3))),
+        Region("b", ((4, 0), (8, 0), (8, 3), (4, 3))),
+        Region("corridor", ((0, 3), (8, 3), (8, 4.2), (0, 4.2))),
+    )
+    doors = (
+        Door(("a", "corridor"), ((1.0, 3), (2.4, 3))),
+        Door(("b", "corridor"), ((5.0, 3), (6.4, 3))),
+    )
+    layout = HouseLayout(regions=regions, doors=doors)
+    seg = segment_rooms(rasterize_house(layout, 0.05))
+    assert len(match_regions(seg.layout().regions, regions, min_iou=0.9)) == 3
+    assert sorted(d.segment for d in seg.doors) == [
+        ((1.0, 3.0), (2.4, 3.0)),
+        ((5.0, 3.0), (6.4, 3.0)),
+    ]
+
+
+def test_an_unknown_method_is_an_error() -> None:
+    grid = rasterize_house(_two_rooms(0.9), 0.1)
+    with pytest.raises(ValueError, match="expected method"):
+        segment_rooms(grid, RoomParams(method="voronoi"))
+
+
+def test_a_wardrobe_against_a_shared_wall_stays_in_its_room() -> None:
+    """Furniture is given whole to the room it stands in, not split with the room behind."""
+    layout = _two_rooms(0.9)
+    wardrobe = Obstacle(
+        name="wardrobe", polygon=((4.05, 2.2), (4.65, 2.2), (4.65, 2.95), (4.05, 2.95))
+    )
+    grid = rasterize_house(HouseLayout(layout.regions, layout.doors, (wardrobe,)), 0.05)
+    seg = segment_rooms(grid)
+    a, b = (Polygon(r.polygon) for r in seg.rooms)
+    centre = Polygon(wardrobe.polygon).centroid
+    assert b.contains(centre) and not a.contains(centre)
+    assert polygon_iou(a, Polygon(layout.regions[0].polygon)) > 0.95
