@@ -354,6 +354,7 @@ class WaypointSearch(Action):
         self._decided_at = -math.inf
         self._visited: list[tuple[float, float]] = []
         self._look: Look | None = None
+        self._look_chosen_at = -math.inf
         self._looking_since: float | None = None
         self._from_door: set[str] = set()
         self._failed: set[tuple[str, str]] = set()
@@ -467,7 +468,7 @@ class WaypointSearch(Action):
             looked_from_door=self._from_door,
             skip=self._failed,
         )
-        self._decided_at = self.t
+        self._look_chosen_at = self.t
         current = self._look
         if not looks:
             return None
@@ -487,7 +488,7 @@ class WaypointSearch(Action):
         no place left to look (the caller falls back to Algorithm 1's frontiers)."""
         look = self._look
         if look is None or (
-            self._looking_since is None and self.t - self._decided_at >= self.REPLAN_S
+            self._looking_since is None and self.t - self._look_chosen_at >= self.REPLAN_S
         ):
             look = self._choose()
             if look is None:
@@ -513,7 +514,7 @@ class WaypointSearch(Action):
             if look.kind == "doorway":
                 self._from_door.add(look.region)
             self._look, self._looking_since = None, None
-            self._decided_at = -math.inf
+            self._look_chosen_at = -math.inf
             self.intents.stop()
             return Status.RUNNING
         pose = self.bb.pose

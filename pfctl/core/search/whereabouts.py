@@ -5,7 +5,8 @@ the time since she was last seen. From where she was last seen she walks room to
 doors at ``walking_speed``; in each room she reaches she either stops there (``stay``) or goes
 on through one of its other doors. The first door is weighted by how she was heading: the door of
 Algorithm 1's heading region l* (the door she was approaching) ``heading_weight`` times any other,
-the door she came in through ``back_weight`` times. Because people at home pause (stop, sit,
+the door she came in through ``back_weight`` times, and she rarely stops before the door she was
+walking toward (``stay_heading``). Because people at home pause (stop, sit,
 turn), the distance she has walked by ``τ`` seconds is taken as uniform on ``[0, v·τ]``: a
 route's region holds the share of that interval its stretch of the route covers — from the door
 she enters it by to the door she leaves by (door-to-door lengths, not centroid guesses), and to
@@ -50,8 +51,14 @@ class WhereaboutsParams:
     stay: float = param(
         0.35, "Chance she stops in a room she reaches rather than going on.", ge=0, le=1
     )
+    stay_heading: float = param(
+        0.1,
+        "Chance she stops in her own room when she was walking toward one of its doors.",
+        ge=0,
+        le=1,
+    )
     heading_weight: float = param(
-        4.0, "Weight of the door she was approaching (l*) against any other door.", ge=0
+        6.0, "Weight of the door she was approaching (l*) against any other door.", ge=0
     )
     back_weight: float = param(0.25, "Weight of the door she came in through.", ge=0)
     p_detect: float = param(
@@ -121,7 +128,8 @@ def spread(
         else:
             weights = {n: 1.0 for n in onward}
         total = sum(weights.values())
-        stay = 1.0 if total <= 0.0 else params.stay
+        stay = params.stay_heading if region == first and heading in weights else params.stay
+        stay = 1.0 if total <= 0.0 else stay
         mass[region] += weight * stay * _share(d_in, math.inf, reach)
         if total <= 0.0 or (d_in > 0.0 and d_in >= reach):
             return  # no door on, or she cannot have got this far: nothing further
