@@ -294,31 +294,38 @@ class Follower:
     def _fit_prediction(self, now: float, seen: Sighting) -> PredictionState | None:
         """§II-E: fit the mission's predictor to the last ``history_s`` of the detected path
         (the paper's weighted SVR), predict ``horizon_s`` ahead, clip to the map, and move the
-        end into free space for the robot."""
+        end into free space for the robot. With ``search.strategy`` belief the place to go is
+        the predicted room's doorway instead (:meth:`_predicted_room`), also when the path is
+        too short to fit."""
         p = self.params.prediction
+        room = self._predicted_room(now)
         h = seen.history
         h = h[h[:, 0] >= seen.t - p.history_s]
         if len(h):  # strictly increasing times
             keep = np.concatenate([[True], np.diff(h[:, 0]) > 1e-6])
             h = h[keep]
-        if len(h) < MIN_POINTS.get(p.model, 3):
+        path = None
+        if len(h) >= MIN_POINTS.get(p.model, 3):
+            times = seen.t + np.arange(1, round(p.horizon_s / p.step_s) + 1) * p.step_s
+            try:
+                model = make_model(p.model, **dict(p.params)).fit(h[:, 0] - h[0, 0], h[:, 1:3])
+                path = np.asarray(model.predict(times - h[0, 0]), dtype=float)
+            except PredictionError:
+                path = None
+        if path is None and room is None:
             return None
-        times = seen.t + np.arange(1, round(p.horizon_s / p.step_s) + 1) * p.step_s
-        try:
-            model = make_model(p.model, **dict(p.params)).fit(h[:, 0] - h[0, 0], h[:, 1:3])
-            path = np.asarray(model.predict(times - h[0, 0]), dtype=float)
-        except PredictionError:
-            return None
-        clipped = clip_prediction(seen.xy, path, self.planner_grid, self.regions)
-        end, region = clipped.end, clipped.region
-        room = self._predicted_room(now)
+        if path is not None:
+            clipped = clip_prediction(seen.xy, path, self.planner_grid, self.regions)
+            xy, end, region = clipped.xy, clipped.end, clipped.region
+        else:  # too short a path for the model: the room alone
+            xy, end, region = np.array([seen.xy], dtype=float), seen.xy, None
         if room is not None:  # the predicted room's doorway, not a point on its wall
             end, region = room
         goal = self.planner.free_goal(end)
         if goal is None:
             return None
-        state = PredictionState(now, seen.xy, clipped.xy, goal, region)
-        self.log.predictions.append(PredictionRecord(now, seen.xy, clipped.xy, goal))
+        state = PredictionState(now, seen.xy, xy, goal, region)
+        self.log.predictions.append(PredictionRecord(now, seen.xy, xy, goal))
         return state
 
     def _predicted_room(self, now: float) -> tuple[tuple[float, float], str] | None:
