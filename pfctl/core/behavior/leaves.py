@@ -458,6 +458,9 @@ class WaypointSearch(Action):
 
     def _choose(self) -> Look | None:
         pose = self.bb.pose
+        p = self.prediction
+        if p is not None and p.reached and p.region is not None:
+            self._from_door.add(p.region)  # go_to_prediction went to its doorway and looked
         control = self.intents.control
         looks = rank_looks(
             self.world.whereabouts,  # type: ignore[arg-type]

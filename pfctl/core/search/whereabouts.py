@@ -40,6 +40,9 @@ from pfctl.core.params import param
 
 XY = tuple[float, float]
 
+#: Routes less likely than this are not followed further (bounds the routes in a dense plan).
+MIN_ROUTE_WEIGHT = 1e-3
+
 __all__ = ["Whereabouts", "WhereaboutsParams", "region_cells", "spread"]
 
 
@@ -111,8 +114,8 @@ def spread(
     mass: dict[str, float] = {name: 0.0 for name in regions.names}
 
     def walk(region: str, entry: XY, d_in: float, weight: float, route: tuple[str, ...]) -> None:
-        if weight <= 1e-9:
-            return
+        if weight < MIN_ROUTE_WEIGHT:
+            return  # a route this unlikely changes no region's mass noticeably
         onward = [n for n in regions.neighbours(region) if n not in route]
         if len(route) >= params.max_rooms:
             onward = []
