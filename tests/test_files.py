@@ -125,6 +125,7 @@ WRITERS = [
     pytest.param(["map", "render", HOUSE], "--png", "m.png", "map.load_source"),
     pytest.param(["map", "annotate", HOUSE], "--png", "m.png", "map.load_source"),
     pytest.param(["mission", "schema"], "--out", "s.json", "mission.dump_json_schema"),
+    pytest.param(["mission", "generate"], "--out", "h.yaml", "mission.make_home"),
     pytest.param(["bt", "show", HOUSE], "--out", "tree.txt", "bt.load_mission"),
     pytest.param(["predict", "t.csv"], "--out", "p.csv", "predict.read_csv_trajectory"),
     pytest.param(["predict", "evaluate", "d"], "--json", "e.json", "predict._load_tracks"),

@@ -1,7 +1,8 @@
 """`pfctl bench`: a campaign of seeded episodes, missions and variants side by side.
 
-``pfctl bench MISSION... [--task follow|search] [--episodes N] [--seed S] [--duration D]
-[--vary KEY=V1,V2,...]... [--workers K | --ray ADDRESS] [--out DIR] [--resume]`` runs episode
+``pfctl bench MISSION... [--homes N --home-seed S] [--task follow|search] [--episodes N]
+[--seed S] [--duration D] [--vary KEY=V1,V2,...]... [--workers K | --ray ADDRESS] [--out DIR]
+[--resume]`` runs episode
 ``i`` (seed ``S + i``) of every mission under every variant (the cross product of the
 ``--vary``s, :mod:`pfctl.bench.variants`) headless in the simulated house — learn the target,
 then follow them (``pfctl follow``) or find them hidden somewhere (``pfctl search``) — in
@@ -11,6 +12,12 @@ the episodes already done (:mod:`pfctl.bench.results`). At the end (also after C
 finished) it prints per mission and variant the mean and 95 % bootstrap interval of each metric
 (:mod:`pfctl.bench.aggregate`) and writes ``summary.csv``, ``summary.md``, ``boxplots.png`` and
 ``episodes.csv`` into ``--out``.
+
+Generated homes: ``--homes N --home-seed S`` writes the homes of seeds ``S..S+N-1`` (``pfctl
+mission generate --seed K``) into ``OUT/homes/`` and runs each of them (default one episode per
+home); a folder given as a MISSION stands for the missions in it. The homes of ``--homes`` (and
+those of one folder) are summarised together, per variant, under one label (``homes``, or the
+folder's name); ``episodes.csv`` keeps each episode's file.
 
 Bad options, missions or ``--vary`` values end in one line and exit status 2 before anything is
 written. A worker process that dies (``kill -9``) has its episode run again on a new one, once;
@@ -34,6 +41,7 @@ import typer
 from rich.console import Console
 
 from pfctl.app.campaign import run_campaign_episode
+from pfctl.app.homes import write_homes
 from pfctl.bench.aggregate import metrics_for, summarize
 from pfctl.bench.episode import BLAS_THREAD_VARIABLES
 from pfctl.bench.plan import (
@@ -63,6 +71,8 @@ from pfctl.files import check_output_dir, write_output
 from pfctl.mission.types import SEED_MAX
 from pfctl.progress import progress_bar
 
+#: The folder of ``--out`` the ``--homes`` are generated into, and their label in the summary.
+HOMES_FOLDER = "homes"
 #: Default simulated seconds of an episode per task.
 DEFAULT_DURATION = {"follow": 120.0, "search": 180.0}
 
@@ -90,15 +100,22 @@ def build_campaign(
     duration: float,
     vary: list[str],
     timeout: float,
+    labels: list[str | None] | None = None,
 ) -> Campaign:
     """The campaign of the command's arguments: every mission under every variant, loaded and
-    validated (one-line :class:`UserError` for the first bad one)."""
+    validated (one-line :class:`UserError` for the first bad one). ``labels``: per mission, the
+    label it is summarised under (the missions of a folder or of ``--homes`` share one), or None
+    for its own (the file's stem)."""
     combos = variants([parse_vary(v) for v in vary])
     paths = [os.path.normpath(p) for p in missions]
     if len(set(paths)) != len(paths):
         raise UserError("MISSION: the same mission file is given twice")
+    own = _labels(paths)
+    given = labels if labels is not None else [None] * len(paths)
     groups = []
-    for label, path in zip(_labels(paths), paths, strict=True):
+    for label, path in zip(
+        [g if g is not None else o for g, o in zip(given, own, strict=True)], paths, strict=True
+    ):
         for variant in combos:
             mission = load_variant(path, variant)
             if task == "search" and mission.scenario.target is None:
@@ -108,7 +125,11 @@ def build_campaign(
 
 
 def _episode_line(record: dict[str, Any], done: int, total: int) -> str:
-    head = f"[{done}/{total}] {record['mission']} · {record['variant']} · seed {record['seed']}: "
+    mission = record["mission"]
+    stem = Path(record["mission_file"]).stem
+    if stem != mission and record["mission_file"] != mission:  # a home of a shared label
+        mission = f"{mission}/{stem}"
+    head = f"[{done}/{total}] {mission} · {record['variant']} · seed {record['seed']}: "
     if record["status"] == "error":
         return head + f"[red]error[/red] {record['error']}"
     m, timing = record["metrics"], record["timing"] or {}
@@ -153,16 +174,41 @@ def _write_summary(
     return [write_output(path, data) for path, data in files]
 
 
+def _expand_folders(missions: list[Path]) -> tuple[list[Path], list[str | None]]:
+    """Mission files, a folder standing for the missions in it (``*.yaml``, sorted, summarised
+    together under the folder's name); each file's shared label or None."""
+    files: list[Path] = []
+    labels: list[str | None] = []
+    for path in missions:
+        if not path.is_dir():
+            files.append(path)
+            labels.append(None)
+            continue
+        inside = sorted(p for p in path.iterdir() if p.suffix in (".yaml", ".yml") and p.is_file())
+        if not inside:
+            raise UserError(f"{path}: a folder without mission files (*.yaml)")
+        files += inside
+        labels += [path.resolve().name or str(path)] * len(inside)
+    return files, labels
+
+
 def bench(
     missions: Annotated[
-        list[Path], typer.Argument(help="Mission YAMLs to run.", show_default=False)
-    ],
+        list[Path] | None,
+        typer.Argument(
+            help="Mission YAMLs to run, or folders of them (e.g. generated homes).",
+            show_default=False,
+        ),
+    ] = None,
     task: Annotated[
         str, typer.Option("--task", help="follow (pfctl follow) or search (pfctl search).")
     ] = "follow",
     episodes: Annotated[
-        int, typer.Option("--episodes", help="Episodes per mission and variant.")
-    ] = 10,
+        int | None,
+        typer.Option(
+            "--episodes", help="Episodes per mission and variant (default 10; with --homes 1)."
+        ),
+    ] = None,
     seed: Annotated[
         int,
         typer.Option("--seed", callback=check_seed, help="Seed of episode 0; episode i: seed + i."),
@@ -204,10 +250,30 @@ def bench(
             help="Wall s before an episode is ended (default max(600, 10 x duration); 0: none).",
         ),
     ] = None,
+    homes: Annotated[
+        int | None,
+        typer.Option(
+            "--homes", help="Also run N generated homes (pfctl mission generate), in OUT/homes/."
+        ),
+    ] = None,
+    home_seed: Annotated[
+        int,
+        typer.Option("--home-seed", callback=check_seed, help="Seed of the first generated home."),
+    ] = 1,
 ) -> None:
     """Run seeded episodes of missions and variants; summarise each metric per variant."""
     seconds = DEFAULT_DURATION.get(task, 120.0) if duration is None else duration
     jobs = (os.cpu_count() or 1) if workers is None else workers
+    if episodes is None:
+        episodes = 1 if homes is not None else 10
+    if homes is not None and homes < 1:
+        raise UserError(f"--homes: expected at least 1, got {homes}")
+    if homes is not None and home_seed + homes - 1 > SEED_MAX:
+        raise UserError(
+            f"--home-seed {home_seed} --homes {homes}: the last home's seed is above {SEED_MAX}"
+        )
+    if not missions and homes is None:
+        raise UserError("MISSION: expected mission files, a folder of missions, or --homes N")
     _check_options(task, episodes, jobs, seconds, timeout)
     if seed + episodes - 1 > SEED_MAX:
         raise UserError(
@@ -221,7 +287,20 @@ def bench(
         raise UserError(f"--ray {ray}: Ray is not installed; {RAY_INSTALL}")
     check_output_dir(out, "--out")
     limit = max(600.0, 10 * seconds) if timeout is None else timeout
-    campaign = build_campaign(missions, task, episodes, seed, seconds, vary or [], limit)
+    files, labels = _expand_folders(missions or [])
+    for v in vary or []:  # a bad --vary is one line before the homes are written
+        parse_vary(v)
+    if homes is not None:
+        seeds = list(range(home_seed, home_seed + homes))
+        Console(stderr=True).print(
+            f"pfctl bench: generating {homes} homes (seeds {seeds[0]}..{seeds[-1]}) into "
+            f"{out / HOMES_FOLDER}",
+            highlight=False,
+            soft_wrap=True,
+        )
+        files += write_homes(out / HOMES_FOLDER, seeds)
+        labels += [HOMES_FOLDER] * homes
+    campaign = build_campaign(files, task, episodes, seed, seconds, vary or [], limit, labels)
     console = Console(stderr=True)
     # Ray is started or reached before anything is written: an unreachable cluster is one line
     ray_owned = connect_ray(ray, jobs) if ray is not None else False

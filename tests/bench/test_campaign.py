@@ -155,3 +155,33 @@ def test_ray_gives_the_same_episodes_as_worker_processes(
     assert all(r["metrics"]["first_identified_s"] is not None for r in pool.values())
     assert len({json.dumps(r["metrics"], sort_keys=True) for r in pool.values()}) == 4
     assert len({r["metrics"]["following_rate"] for r in pool.values()}) > 1
+
+
+def test_a_campaign_runs_generated_homes_and_summarises_them_per_variant(tmp_path: Path) -> None:
+    """``--homes 2``: two generated homes written into OUT/homes and one episode each under
+    each variant; the summary has one row per variant over both homes (issue 22, item 1)."""
+    out = tmp_path / "homes-bench"
+    tree = HOUSE.parent / "trees" / "last_seen.yaml"
+    done = subprocess.run(
+        [sys.executable, "-m", "pfctl", "bench", "--homes", "2", "--home-seed", "3",
+         "--duration", "8", "--workers", "2", "--vary",
+         f"behavior.tree=@{HOUSE.parent / 'trees' / 'paper.yaml'},@{tree}", "--out", str(out)],
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert sorted(p.name for p in (out / "homes").iterdir()) == ["home-0003.yaml", "home-0004.yaml"]
+    records = _records(out)
+    assert sorted((Path(r["mission_file"]).name, r["variant"]) for r in records) == [
+        ("home-0003.yaml", "behavior.tree=last_seen"),
+        ("home-0003.yaml", "behavior.tree=paper"),
+        ("home-0004.yaml", "behavior.tree=last_seen"),
+        ("home-0004.yaml", "behavior.tree=paper"),
+    ]
+    rows = [line.split(",") for line in (out / "summary.csv").read_text().splitlines()[1:]]
+    following = [(r[0], r[1], r[8]) for r in rows if r[2] == "following_rate"]
+    assert following == [
+        ("homes", "behavior.tree=paper", "2"),
+        ("homes", "behavior.tree=last_seen", "2"),
+    ]
