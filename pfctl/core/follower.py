@@ -76,7 +76,13 @@ from pfctl.core.episode import (
 )
 from pfctl.core.mapping.grid import FREE, InverseSensorModel, OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, heading_region
+from pfctl.core.mapping.regions import (
+    RegionMap,
+    SearchParams,
+    WaypointDecision,
+    heading_region,
+    heading_scores,
+)
 from pfctl.core.params import param
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.clipping import clip_prediction
@@ -277,14 +283,17 @@ class Follower:
             return
         h = seen.history.reshape(-1, 3)
         recent = since_region_entered(h, self.regions)
-        heading = heading_region(recent, self.regions, self.params.search.heading_window_s)
+        window = self.params.search.heading_window_s
+        heading = heading_region(recent, self.regions, window)
+        _, scores = heading_scores(recent, self.regions, window)
         current = self.regions.locate(seen.xy)
         came_from = None
         for _, x, y in h[: len(h) - len(recent)][::-1]:
             came_from = self.regions.locate((x, y))
             if came_from is not None:
                 break
-        whereabouts.lost(seen.t, seen.xy, heading=heading, came_from=came_from)
+        approach = {n: -v for n, v in scores.items() if v < 0.0}
+        whereabouts.lost(seen.t, seen.xy, heading=heading, came_from=came_from, approach=approach)
         horizon = self.params.room_horizon_s
         ranked = sorted(whereabouts.prior(seen.t + horizon).items(), key=lambda kv: (-kv[1], kv[0]))
         self.log.room_predictions.append(

@@ -3,10 +3,12 @@
 The prior (:func:`spread`) says how far she can have walked along the region graph of §II-B in
 the time since she was last seen. From where she was last seen she walks room to room through
 doors at ``walking_speed``; in each room she reaches she either stops there (``stay``) or goes
-on through one of its other doors. The first door is weighted by how she was heading: the door of
-Algorithm 1's heading region l* (the door she was approaching) ``heading_weight`` times any other,
-the door she came in through ``back_weight`` times, and she rarely stops before the door she was
-walking toward (``stay_heading``). Because people at home pause (stop, sit,
+on through one of its other doors. The first door is weighted by how she was heading: a door she
+was approaching (Algorithm 1's heading scores, :func:`~pfctl.core.mapping.regions.heading_scores`)
+up to ``heading_weight`` times any other, in proportion to how fast she approached it (the door
+of l* the most: along a corridor she approaches every door ahead, not only the nearest), the door
+she came in through ``back_weight`` times, and she rarely stops before the doors she was walking
+toward (``stay_heading``). Because people at home pause (stop, sit,
 turn), the distance she has walked by ``τ`` seconds is taken as uniform on ``[0, v·τ]``: a
 route's region holds the share of that interval its stretch of the route covers — from the door
 she enters it by to the door she leaves by (door-to-door lengths, not centroid guesses), and to
@@ -27,6 +29,7 @@ A target never seen (``pfctl search``) has the uniform prior over the regions th
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import networkx as nx
@@ -102,15 +105,23 @@ def spread(
     *,
     heading: str | None = None,
     came_from: str | None = None,
+    approach: Mapping[str, float] | None = None,
 ) -> dict[str, float]:
     """The prior over regions ``elapsed_s`` after she was last seen at ``start`` (module
     docstring): {region: probability}, summing to 1 over the regions reachable from her region
     (all of it on her region at τ = 0). ``heading`` is l*, ``came_from`` the region she was in
-    before. Empty when ``start`` lies outside every region."""
+    before, ``approach`` the speed (m/s or any unit) at which she approached the door of each
+    neighbour she approached (default: l*'s alone). Empty when ``start`` lies outside every
+    region."""
     first = regions.locate(start)
     if first is None:
         return {}
     reach = params.walking_speed * max(elapsed_s, 0.0)
+    rates = {n: a for n, a in (approach or {}).items() if a > 0.0}
+    if not rates and heading is not None:
+        rates = {heading: 1.0}
+    fastest = max(rates.values(), default=1.0)
+    bonus = {n: 1.0 + (params.heading_weight - 1.0) * a / fastest for n, a in rates.items()}
     mass: dict[str, float] = {name: 0.0 for name in regions.names}
 
     def walk(region: str, entry: XY, d_in: float, weight: float, route: tuple[str, ...]) -> None:
@@ -121,17 +132,12 @@ def spread(
             onward = []
         if region == first:
             weights = {
-                n: params.heading_weight
-                if n == heading
-                else params.back_weight
-                if n == came_from
-                else 1.0
-                for n in onward
+                n: bonus.get(n, params.back_weight if n == came_from else 1.0) for n in onward
             }
         else:
             weights = {n: 1.0 for n in onward}
         total = sum(weights.values())
-        stay = params.stay_heading if region == first and heading in weights else params.stay
+        stay = params.stay_heading if region == first and bonus.keys() & weights else params.stay
         stay = 1.0 if total <= 0.0 else stay
         mass[region] += weight * stay * _share(d_in, math.inf, reach)
         if total <= 0.0 or (d_in > 0.0 and d_in >= reach):
@@ -182,18 +188,26 @@ class Whereabouts:
         self.lost_at: float | None = None
         self.heading: str | None = None
         self.came_from: str | None = None
+        self.approach: dict[str, float] = {}
         self.active = False
         self._uniform: dict[str, float] | None = None
 
     # -- what happened -----------------------------------------------------------------------------
 
     def lost(
-        self, t: float, start: XY, *, heading: str | None = None, came_from: str | None = None
+        self,
+        t: float,
+        start: XY,
+        *,
+        heading: str | None = None,
+        came_from: str | None = None,
+        approach: Mapping[str, float] | None = None,
     ) -> None:
         """She was last seen at ``start`` at ``t``, heading for ``heading`` (l*), coming from
         ``came_from``. What the camera saw before counts no more (she was elsewhere then)."""
         self.start, self.lost_at = start, t
         self.heading, self.came_from = heading, came_from
+        self.approach = dict(approach or {})
         self.seen_at[:] = -math.inf
         self._uniform = None
         self.active = True
@@ -208,6 +222,7 @@ class Whereabouts:
             names = [n for n in names if n in reachable]
         self._uniform = {n: 1.0 / len(names) for n in names}
         self.start, self.lost_at, self.heading, self.came_from = None, t, None, None
+        self.approach = {}
         self.seen_at[:] = -math.inf
         self.active = True
 
@@ -235,6 +250,7 @@ class Whereabouts:
             self.params,
             heading=self.heading,
             came_from=self.came_from,
+            approach=self.approach,
         )
 
     def seen_fraction(self, t: float) -> NDArray[np.float64]:
