@@ -346,6 +346,8 @@ class WaypointSearch(Action):
 
     #: A new look replaces the one under way only when it scores this much better.
     SWITCH_GAIN: ClassVar[float] = 1.3
+    #: Looks inside one room (at its parts not seen yet) before the rest counts as unseeable.
+    INSIDE_LOOKS: ClassVar[int] = 3
     #: Head sweep to either side of the room's bearing while looking, rad.
     LOOK_PAN: ClassVar[float] = 0.9
 
@@ -358,6 +360,7 @@ class WaypointSearch(Action):
         self._looking_since: float | None = None
         self._from_door: set[str] = set()
         self._failed: set[tuple[str, str]] = set()
+        self._inside: dict[str, int] = {}
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
         return all(math.dist(goal, v) >= self.VISITED_RADIUS for v in self._visited)
@@ -516,6 +519,10 @@ class WaypointSearch(Action):
         if elapsed >= seconds:
             if look.kind == "doorway":
                 self._from_door.add(look.region)
+            else:
+                self._inside[look.region] = self._inside.get(look.region, 0) + 1
+                if self._inside[look.region] >= self.INSIDE_LOOKS:
+                    self._failed.add((look.region, "inside"))  # the rest cannot be seen
             self._look, self._looking_since = None, None
             self._look_chosen_at = -math.inf
             self.intents.stop()

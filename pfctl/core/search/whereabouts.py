@@ -16,11 +16,14 @@ infinity for the room she stops in. So the belief starts in her room, spreads al
 (never through walls) as τ grows, and favours the way she was heading.
 
 The evidence (:class:`Whereabouts`) is the camera's negative observations — the cells of the
-human belief grid (Eq. 4) that the camera saw without a person in them. A region's mass is
-multiplied by ``1 − p_detect · f`` with ``f`` the share of its walkable cells seen within the last
-``forget_s`` seconds (she may walk back into a room looked at long ago), then the regions are
-normalised: a room looked into and found empty loses its mass and the rest gain it. Within a
-region the mass sits on its cells not seen lately (:meth:`Whereabouts.cell_probabilities`).
+human belief grid (Eq. 4) that the camera saw without a person in them. A region loses
+``p_detect · f · prior(t_seen)``, with ``f`` the share of its walkable cells seen since the loss
+and ``t_seen`` when they were seen (on average): the mass it held then was looked at and was not
+her, and only what the prior says can have walked in since comes back (a dead-end room she could
+have reached long ago stays empty once seen; a room seen before she could reach it fills again).
+Then the regions are normalised: a room looked into and found empty loses its mass and the rest
+gain it. Within a region the mass sits on its cells not seen yet
+(:meth:`Whereabouts.cell_probabilities`).
 
 A target never seen (``pfctl search``) has the uniform prior over the regions the robot can reach
 (:meth:`Whereabouts.never_seen`), weighted by nothing else, with the same evidence.
@@ -69,9 +72,6 @@ class WhereaboutsParams:
     back_weight: float = param(0.25, "Weight of the door she came in through.", ge=0)
     p_detect: float = param(
         0.9, "Chance the camera shows her if she is in a cell it sees.", ge=0, le=1
-    )
-    forget_s: float = param(
-        25.0, "A cell seen empty this long ago counts as unseen again.", unit="s", gt=0
     )
     max_rooms: int = 10
     """Routes are followed through at most this many regions."""
@@ -253,24 +253,40 @@ class Whereabouts:
             approach=self.approach,
         )
 
-    def seen_fraction(self, t: float) -> NDArray[np.float64]:
+    def seen_fraction(self) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
         """Per region (``regions.names`` order): the share of its walkable cells seen empty
-        within the last ``forget_s`` seconds."""
-        recent = (self.seen_at >= t - self.params.forget_s) & (self.labels >= 0)
-        seen = np.bincount(self.labels[recent], minlength=len(self.regions.names))
-        return np.where(self._cells > 0, seen / np.maximum(self._cells, 1), 1.0)
+        since the loss, and the mean time they were (last) seen (NaN where none was)."""
+        seen = np.isfinite(self.seen_at) & (self.labels >= 0)
+        n = len(self.regions.names)
+        count = np.bincount(self.labels[seen], minlength=n)
+        when = np.bincount(self.labels[seen], weights=self.seen_at[seen], minlength=n)
+        share = np.where(self._cells > 0, count / np.maximum(self._cells, 1), 1.0)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mean = np.where(count > 0, when / np.maximum(count, 1), np.nan)
+        return share, mean
 
     def probabilities(self, t: float) -> dict[str, float]:
-        """The posterior over regions at ``t``: the prior times ``1 − p_detect · seen share``,
-        normalised (the prior itself when everything was seen)."""
+        """The posterior over regions at ``t`` (module docstring): each region's prior less the
+        mass the camera saw it did not hold — ``p_detect`` × its seen share × its prior when it
+        was seen (at most its prior now) — so a room seen empty gets back only what can have
+        walked in since; then normalised (the prior itself when nothing is left)."""
         prior = self.prior(t)
         if not prior:
             return {}
-        seen = self.seen_fraction(t)
+        share, when = self.seen_fraction()
         index = {n: i for i, n in enumerate(self.regions.names)}
-        post = {
-            n: p * (1.0 - self.params.p_detect * float(seen[index[n]])) for n, p in prior.items()
-        }
+        then: dict[float, dict[str, float]] = {}
+        post: dict[str, float] = {}
+        for name, p in prior.items():
+            i = index[name]
+            if share[i] <= 0.0 or not np.isfinite(when[i]):
+                post[name] = p
+                continue
+            at = float(min(when[i], t))
+            if at not in then:
+                then[at] = self.prior(at)
+            seen_then = min(p, then[at].get(name, 0.0))
+            post[name] = p - self.params.p_detect * float(share[i]) * seen_then
         total = sum(post.values())
         if total <= 1e-12:
             return prior
@@ -281,13 +297,14 @@ class Whereabouts:
         return sorted(self.probabilities(t).items(), key=lambda kv: (-kv[1], kv[0]))
 
     def unseen_cells(self, t: float, region: str) -> NDArray[np.bool_]:
-        """The walkable cells of ``region`` not seen within the last ``forget_s`` seconds."""
+        """The walkable cells of ``region`` not seen since the loss (``t`` is kept for the
+        callers' clock)."""
         i = self.regions.names.index(region)
-        return (self.labels == i) & (self.seen_at < t - self.params.forget_s)
+        return (self.labels == i) & ~np.isfinite(self.seen_at)
 
     def cell_probabilities(self, t: float) -> NDArray[np.float64]:
         """The belief over cells: each region's posterior spread evenly over its cells not seen
-        lately (over all its cells when every one was seen)."""
+        yet (over all its cells when every one was seen)."""
         out = np.zeros(self.geometry.shape)
         for name, p in self.probabilities(t).items():
             cells = self.unseen_cells(t, name)

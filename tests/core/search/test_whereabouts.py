@@ -68,8 +68,8 @@ def test_a_room_seen_empty_loses_its_mass_and_the_others_gain(regions: RegionMap
     assert after["east"] < 0.25 * before["east"]
     assert all(after[r] > before[r] for r in ("corridor", "west", "mid"))
     assert sum(after.values()) == pytest.approx(1.0)
-    # looked at long ago, the room counts again (she may have walked back in)
-    assert wb.probabilities(10.0 + PARAMS.forget_s + 1.0)["east"] > after["east"]
+    # later only what can have walked in since comes back, not the mass that was seen
+    assert wb.probabilities(60.0)["east"] < wb.prior(60.0)["east"] - 0.15
     # the cells: the seen room's mass is gone from them, the rest sums to one
     cells = wb.cell_probabilities(10.0)
     assert cells.sum() == pytest.approx(1.0) and cells[east].sum() == pytest.approx(after["east"])
@@ -81,3 +81,13 @@ def test_a_target_never_seen_is_anywhere_the_robot_can_reach_alike(regions: Regi
     p = wb.probabilities(30.0)
     assert set(p) == {"corridor", "west", "mid", "east"}
     assert all(v == pytest.approx(0.25) for v in p.values())
+
+
+def test_a_room_seen_before_she_could_reach_it_fills_again(regions: RegionMap) -> None:
+    wb = Whereabouts(regions, GEOMETRY, np.ones(GEOMETRY.shape, dtype=bool), PARAMS)
+    wb.lost(0.0, (1.5, 4.0))  # in the west room; east is 9 m away by the doors
+    east = wb.labels == wb.regions.names.index("east")
+    wb.observe(1.0, east)
+    assert wb.probabilities(1.0).get("east", 0.0) == pytest.approx(0.0)
+    later = wb.probabilities(60.0)["east"]
+    assert later > 0.5 * wb.prior(60.0)["east"]
