@@ -346,6 +346,9 @@ class WaypointSearch(Action):
 
     #: A new look replaces the one under way only when it scores this much better.
     SWITCH_GAIN: ClassVar[float] = 1.3
+    #: A place the robot could not drive to (a person in the door, say) is tried again after
+    #: this long, s: a likely room is not given up for good.
+    RETRY_S: ClassVar[float] = 10.0
     #: Looks inside one room (at its parts not seen yet) before the rest counts as unseeable.
     INSIDE_LOOKS: ClassVar[int] = 3
     #: Head sweep to either side of the room's bearing while looking, rad.
@@ -360,6 +363,8 @@ class WaypointSearch(Action):
         self._looking_since: float | None = None
         self._from_door: set[str] = set()
         self._failed: set[tuple[str, str]] = set()
+        self._unreachable: dict[tuple[str, str], float] = {}
+        """Looks the robot could not drive to, and when: skipped for ``RETRY_S``."""
         self._inside: dict[str, int] = {}
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
@@ -472,7 +477,8 @@ class WaypointSearch(Action):
             robot_speed=control.max_linear_speed,
             look_s=self.world.search.look_s,
             looked_from_door=self._from_door,
-            skip=self._failed,
+            skip=self._failed
+            | {k for k, at in self._unreachable.items() if self.t - at < self.RETRY_S},
         )
         self._look_chosen_at = self.t
         current = self._look
@@ -509,7 +515,7 @@ class WaypointSearch(Action):
                 self.intents.look_at(look.look_at, "sweep")
                 return Status.RUNNING
             if outcome == "failed":
-                self._failed.add((look.region, look.kind))
+                self._unreachable[(look.region, look.kind)] = self.t
                 self._look = None
                 self.intents.stop()
                 return Status.RUNNING
