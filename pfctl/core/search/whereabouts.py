@@ -139,13 +139,16 @@ def spread(
         total = sum(weights.values())
         stay = params.stay_heading if region == first and bonus.keys() & weights else params.stay
         stay = 1.0 if total <= 0.0 else stay
-        mass[region] += weight * stay * _share(d_in, math.inf, reach)
+        kept = stay + (1.0 - stay) * (1.0 - total / max(total, len(weights), 1))
+        mass[region] += weight * kept * _share(d_in, math.inf, reach)
         if total <= 0.0 or (d_in > 0.0 and d_in >= reach):
             return  # no door on, or she cannot have got this far: nothing further
         for n, w in weights.items():
             door = _door_point(regions, region, n, entry)
             d_out = d_in + math.dist(entry, door)
-            share = weight * (1.0 - stay) * w / total
+            # a door weighs against an ordinary door's 1, not only against the others: the one
+            # door back out of the room she just entered keeps its back_weight
+            share = weight * (1.0 - stay) * w / max(total, len(weights))
             mass[region] += share * _share(d_in, d_out, reach)
             walk(n, door, d_out, share, (*route, n))
 

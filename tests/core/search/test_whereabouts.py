@@ -91,3 +91,10 @@ def test_a_room_seen_before_she_could_reach_it_fills_again(regions: RegionMap) -
     assert wb.probabilities(1.0).get("east", 0.0) == pytest.approx(0.0)
     later = wb.probabilities(60.0)["east"]
     assert later > 0.5 * wb.prior(60.0)["east"]
+
+
+def test_just_in_through_the_only_door_she_is_most_likely_still_in_there(
+    regions: RegionMap,
+) -> None:
+    p = spread(regions, (1.5, 2.5), 5.0, PARAMS, came_from="corridor")
+    assert max(p, key=p.__getitem__) == "west"
