@@ -19,7 +19,8 @@ from rich.console import Console
 
 from pfctl.app.episodes import hide_target, metric_params, run_sim_episode, target_profile
 from pfctl.bench.plan import EpisodeSpec
-from pfctl.core.metrics import follow_metrics, search_metrics
+from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.metrics import follow_metrics, room_prediction_scores, search_metrics
 
 #: How the follower re-acquired a lost target (:class:`~pfctl.core.metrics.Reacquisition`).
 HOW = ("prediction", "waypoint_search", "other")
@@ -74,6 +75,7 @@ def run_campaign_episode(spec: EpisodeSpec) -> tuple[str, dict[str, Any], dict[s
             "collisions": follow.collisions,
             "distance_m": follow.distance_m,
             "duration_s": follow.duration_s,
+            **room_prediction_scores(result.log, RegionMap(mission.layout()), params).to_json(),
         }
     metrics["sim_time_s"] = result.sim_time
     ticks = 1000.0 * np.asarray(result.tick_seconds, dtype=float)

@@ -5,7 +5,9 @@ The unit of resampling is the episode. Every metric is a ratio of sums over the 
 
 follow — ``following_rate`` (mean of the episodes' rates), ``refind_success`` (re-acquired
 losses / losses), ``time_to_refind_s`` (mean over all re-acquisitions), ``identity_switches``,
-``collisions`` and ``path_length_m`` (means per episode);
+``collisions`` and ``path_length_m`` (means per episode), ``room_top1``/``room_top2`` (the room
+predicted at a loss was where she was a few seconds later / among the first two, over the scored
+losses) and ``room_heading_top1``/``room_heading_top2`` (the same for Algorithm 1's l*);
 
 search — ``found_rate`` (episodes that found the target / episodes), ``time_to_find_s`` (mean
 over the episodes that found the target), ``collisions``, ``path_length_m``.
@@ -64,6 +66,14 @@ def _field(name: str) -> Callable[[dict[str, Any]], float]:
     return lambda m: float(m[name])
 
 
+def _field_or_zero(name: str) -> Callable[[dict[str, Any]], float]:
+    return lambda m: float(m.get(name, 0))
+
+
+def _share(name: str) -> Callable[[dict[str, Any]], list[float]]:
+    return lambda m: [m[name] / m["room_scored"]] if m.get("room_scored") else []
+
+
 def _value(name: str) -> Callable[[dict[str, Any]], list[float]]:
     return lambda m: [float(m[name])]
 
@@ -105,6 +115,23 @@ FOLLOW_METRICS: tuple[Metric, ...] = (
     ),
     Metric("collisions", "collisions", "", _field("collisions"), _one, _value("collisions")),
     Metric("path_length_m", "path length", "m", _field("distance_m"), _one, _value("distance_m")),
+    *(
+        Metric(
+            f"room_{key}",
+            label,
+            "",
+            _field_or_zero(f"room_{key}"),
+            _field_or_zero("room_scored"),
+            _share(f"room_{key}"),
+            percent=True,
+        )
+        for key, label in (
+            ("top1", "room top-1"),
+            ("top2", "room top-2"),
+            ("heading_top1", "room top-1 of l*"),
+            ("heading_top2", "room top-2 of l*"),
+        )
+    ),
 )
 
 SEARCH_METRICS: tuple[Metric, ...] = (

@@ -75,6 +75,19 @@ class PredictionRecord:
 
 
 @dataclass(frozen=True)
+class RoomPredictionRecord:
+    """Which room the lost target is in ``horizon_s`` after the loss at ``t``, as the belief over
+    where she can be predicts it (``ranked``, most likely first), beside Algorithm 1's answer:
+    ``heading`` (l*, the room she was last seen heading to) and ``current`` (her room then)."""
+
+    t: float
+    ranked: tuple[str, ...]
+    heading: str | None
+    current: str | None
+    horizon_s: float
+
+
+@dataclass(frozen=True)
 class WaypointRecord:
     """A way-point Algorithm 1 chose."""
 
@@ -349,6 +362,7 @@ class EpisodeLog:
     """The truth at each tick's instant (same length as ``ticks`` when known)."""
     predictions: list[PredictionRecord] = field(default_factory=list)
     waypoints: list[WaypointRecord] = field(default_factory=list)
+    room_predictions: list[RoomPredictionRecord] = field(default_factory=list)
     target_name: str | None = None
     """The scenario's target (simulator), for the metrics."""
     tracks: PackedRecords[TrackRow] = field(default_factory=packed_factory(TrackRowCodec))
@@ -372,6 +386,7 @@ __all__ = [
     "EpisodeLog",
     "GroundTruthCodec",
     "PredictionRecord",
+    "RoomPredictionRecord",
     "TickCodec",
     "TickColumns",
     "TickRecord",

@@ -60,7 +60,7 @@ from pfctl.core.behavior.intents import (
 )
 from pfctl.core.behavior.leaves import PREDICTION_ACTIONS, SEARCH_ACTIONS, leaf_factory
 from pfctl.core.behavior.tree import build_tree
-from pfctl.core.behavior.world import WorldModel
+from pfctl.core.behavior.world import WorldModel, since_region_entered
 from pfctl.core.control import (
     KNOWN_RADIUS,
     PEAK_CANDIDATES,
@@ -69,10 +69,22 @@ from pfctl.core.control import (
     gaze_angles,
     gaze_rule,
 )
-from pfctl.core.episode import EpisodeLog, PredictionRecord, TickRecord, WaypointRecord
-from pfctl.core.mapping.grid import InverseSensorModel, OccupancyGrid
+from pfctl.core.episode import (
+    EpisodeLog,
+    PredictionRecord,
+    RoomPredictionRecord,
+    TickRecord,
+    WaypointRecord,
+)
+from pfctl.core.mapping.grid import FREE, InverseSensorModel, OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
+from pfctl.core.mapping.regions import (
+    RegionMap,
+    SearchParams,
+    WaypointDecision,
+    heading_region,
+    heading_scores,
+)
 from pfctl.core.params import param
 from pfctl.core.perception.pipeline import Perception
 from pfctl.core.prediction.clipping import clip_prediction
@@ -84,6 +96,8 @@ from pfctl.core.prediction.models import (
     make_model,
 )
 from pfctl.core.robot import STOP, HeadTarget, Observation, Pose2D, Robot
+from pfctl.core.search.next_look import doorway
+from pfctl.core.search.whereabouts import Whereabouts
 
 
 @dataclass(frozen=True)
@@ -122,6 +136,8 @@ class FollowerParams:
     """How much of the target's detected path is kept, seconds."""
     belief_threshold: float = 0.3
     """The gaze looks at the belief peak only above this probability."""
+    room_horizon_s: float = 5.0
+    """The room prediction made at a loss is of where she is this long after it, s."""
 
 
 class Follower:
@@ -154,7 +170,8 @@ class Follower:
         self.grid = OccupancyGrid(static_map.geometry, sensor_model=sensor_model)
         self.planner = GridPlanner(static_map, robot_radius)
         self.dt = 1.0 / params.tick_hz
-        self.world = WorldModel(self.grid, self.planner, regions, params.search)
+        whereabouts = Whereabouts(regions, static_map.geometry, static_map.states() == FREE)
+        self.world = WorldModel(self.grid, self.planner, regions, params.search, whereabouts)
         self.navigation = Navigation()
         self.intents = Intents(params.control, self.world, self.navigation)
         self.gaze = GazeController(params.control)
@@ -181,6 +198,7 @@ class Follower:
         self._last_waypoint: object = None
         self._closed = False
         self.ticks = 0
+        self.robot_pose: tuple[float, float] | None = None
 
     # -- the tick ---------------------------------------------------------------------------------
 
@@ -197,6 +215,7 @@ class Follower:
         """What the robot senses now (Robot port), and the status of its navigation goal."""
         obs = self.robot.observe()
         self._now = obs.stamp
+        self.robot_pose = (obs.pose.x, obs.pose.y)
         self.navigation.status = self.robot.nav_status()
         return obs
 
@@ -208,8 +227,14 @@ class Follower:
         if scan is not None:
             self.perception.on_scan(scan)
             self.log.tracks += self.perception.seen_track_rows(scan.stamp)
+        whereabouts = self.world.whereabouts
         if obs.rgbd is not None:
             self.perception.on_frame(obs.rgbd)
+            visible = self.perception.last_visible
+            if whereabouts is not None and visible is not None:
+                whereabouts.observe(obs.rgbd.stamp, visible)
+        if whereabouts is not None and self._last_seen is None and not whereabouts.active:
+            whereabouts.never_seen(obs.stamp, (obs.pose.x, obs.pose.y))
         if scan is not None:
             self._last_scan_stamp = scan.stamp
             self.grid.update_scan(
@@ -251,35 +276,90 @@ class Follower:
                 target.last_detected, target.xy, np.array(self._path, dtype=float)
             )
             self._prediction = None
+            if self.world.whereabouts is not None:
+                self.world.whereabouts.found()
         elif self._had_target and self._last_seen is not None:
+            self._lost(now, self._last_seen)
             self._prediction = self._fit_prediction(now, self._last_seen)
         self._had_target = visible
+
+    def _lost(self, now: float, seen: Sighting) -> None:
+        """Start the belief over where she can be from the last sighting (heading for
+        Algorithm 1's l*, coming from the region she was in before) and log its room prediction
+        ``room_horizon_s`` ahead beside l* (issue 22, item 2)."""
+        whereabouts = self.world.whereabouts
+        if whereabouts is None:
+            return
+        h = seen.history.reshape(-1, 3)
+        recent = since_region_entered(h, self.regions)
+        window = self.params.search.heading_window_s
+        heading = heading_region(recent, self.regions, window)
+        _, scores = heading_scores(recent, self.regions, window)
+        current = self.regions.locate(seen.xy)
+        came_from = None
+        for _, x, y in h[: len(h) - len(recent)][::-1]:
+            came_from = self.regions.locate((x, y))
+            if came_from is not None:
+                break
+        approach = {n: -v for n, v in scores.items() if v < 0.0}
+        whereabouts.lost(seen.t, seen.xy, heading=heading, came_from=came_from, approach=approach)
+        horizon = self.params.room_horizon_s
+        ranked = sorted(whereabouts.prior(seen.t + horizon).items(), key=lambda kv: (-kv[1], kv[0]))
+        self.log.room_predictions.append(
+            RoomPredictionRecord(now, tuple(n for n, _ in ranked), heading, current, horizon)
+        )
 
     def _fit_prediction(self, now: float, seen: Sighting) -> PredictionState | None:
         """§II-E: fit the mission's predictor to the last ``history_s`` of the detected path
         (the paper's weighted SVR), predict ``horizon_s`` ahead, clip to the map, and move the
-        end into free space for the robot."""
+        end into free space for the robot. With ``search.strategy`` belief the place to go is
+        the predicted room's doorway instead (:meth:`_predicted_room`), also when the path is
+        too short to fit."""
         p = self.params.prediction
+        room = self._predicted_room(now)
         h = seen.history
         h = h[h[:, 0] >= seen.t - p.history_s]
         if len(h):  # strictly increasing times
             keep = np.concatenate([[True], np.diff(h[:, 0]) > 1e-6])
             h = h[keep]
-        if len(h) < MIN_POINTS.get(p.model, 3):
+        path = None
+        if len(h) >= MIN_POINTS.get(p.model, 3):
+            times = seen.t + np.arange(1, round(p.horizon_s / p.step_s) + 1) * p.step_s
+            try:
+                model = make_model(p.model, **dict(p.params)).fit(h[:, 0] - h[0, 0], h[:, 1:3])
+                path = np.asarray(model.predict(times - h[0, 0]), dtype=float)
+            except PredictionError:
+                path = None
+        if path is None and room is None:
             return None
-        times = seen.t + np.arange(1, round(p.horizon_s / p.step_s) + 1) * p.step_s
-        try:
-            model = make_model(p.model, **dict(p.params)).fit(h[:, 0] - h[0, 0], h[:, 1:3])
-            path = np.asarray(model.predict(times - h[0, 0]), dtype=float)
-        except PredictionError:
-            return None
-        clipped = clip_prediction(seen.xy, path, self.planner_grid, self.regions)
-        goal = self.planner.free_goal(clipped.end)
+        if path is not None:
+            clipped = clip_prediction(seen.xy, path, self.planner_grid, self.regions)
+            xy, end, region = clipped.xy, clipped.end, clipped.region
+        else:  # too short a path for the model: the room alone
+            xy, end, region = np.array([seen.xy], dtype=float), seen.xy, None
+        if room is not None:  # the predicted room's doorway, not a point on its wall
+            end, region = room
+        goal = self.planner.free_goal(end)
         if goal is None:
             return None
-        state = PredictionState(now, seen.xy, clipped.xy, goal, clipped.region)
-        self.log.predictions.append(PredictionRecord(now, seen.xy, clipped.xy, goal))
+        state = PredictionState(now, seen.xy, xy, goal, region)
+        self.log.predictions.append(PredictionRecord(now, seen.xy, xy, goal))
         return state
+
+    def _predicted_room(self, now: float) -> tuple[tuple[float, float], str] | None:
+        """With ``search.strategy`` belief: the most probable room a few seconds on and where
+        to look into it from (its doorway on the robot's way; the last sighting when she is
+        most likely still in the robot's room or her own). None with the paper's strategy."""
+        whereabouts = self.world.whereabouts
+        if self.params.search.strategy != "belief" or whereabouts is None:
+            return None
+        ranked = whereabouts.ranked(now + self.params.room_horizon_s)
+        if not ranked or whereabouts.start is None:
+            return None
+        room = ranked[0][0]
+        pose = self.robot_pose
+        door = doorway(self.regions, pose, room) if pose is not None else None
+        return (door[0] if door is not None else whereabouts.start), room
 
     @property
     def planner_grid(self) -> OccupancyGrid:

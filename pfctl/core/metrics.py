@@ -46,6 +46,14 @@ Search episodes (:func:`search_metrics`): **found** when a correct tick exists;
 count up to that tick (the cost of finding), over the whole episode when the target was never
 found.
 
+Room prediction (:func:`room_prediction_scores`): at each loss the follower logged which room the
+belief over where she can be predicts for ``horizon_s`` later (:class:`RoomPredictionRecord`, the
+last one made at or before ``t_lost``); its **top-1** / **top-2** hit when the room the true
+target is in at ``t_lost + horizon_s`` is its first / among its first two. The baseline is
+Algorithm 1's answer, "the room she was last seen heading to": l* (her own room when she
+approached no door) for top-1, l* then her own room for top-2. Losses whose horizon runs past the
+episode's end, or whose true position lies in no region, are not scored.
+
 Without truths (a real robot) nothing can say whether the track was the right person, so the
 robot's belief stands in: a tick is correct when its awareness is in :data:`HAS_TARGET`, no tick
 is wrong (``identity_switches`` is 0), and the following rate uses the robot's own estimate of
@@ -66,6 +74,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from pfctl.core.episode import HAS_TARGET, EpisodeLog, tick_columns, truth_columns
+from pfctl.core.mapping.regions import RegionMap
 from pfctl.core.params import param
 
 FloatArray = NDArray[np.float64]
@@ -452,10 +461,69 @@ __all__ = [
     "FollowMetrics",
     "MetricParams",
     "Reacquisition",
+    "RoomPredictionScores",
     "SearchMetrics",
     "episode_arrays",
     "follow_metrics",
     "path_length",
+    "room_prediction_scores",
     "runs",
     "search_metrics",
 ]
+
+
+@dataclass(frozen=True)
+class RoomPredictionScores:
+    """Room prediction at the moment of loss against the truth (module docstring): counts."""
+
+    scored: int = 0
+    top1: int = 0
+    top2: int = 0
+    heading_top1: int = 0
+    """Hits of l* (Algorithm 1's heading region; her own room without one)."""
+    heading_top2: int = 0
+    """Hits of l* or her own room."""
+
+    def to_json(self) -> dict[str, int]:
+        return {
+            "room_scored": self.scored,
+            "room_top1": self.top1,
+            "room_top2": self.top2,
+            "room_heading_top1": self.heading_top1,
+            "room_heading_top2": self.heading_top2,
+        }
+
+
+def room_prediction_scores(
+    log: EpisodeLog, regions: RegionMap, params: MetricParams | None = None
+) -> RoomPredictionScores:
+    """Score the room predictions logged at the losses of :func:`follow_metrics` (module
+    docstring); all zero without truths or room predictions."""
+    if not log.truths or not log.room_predictions:
+        return RoomPredictionScores()
+    a = episode_arrays(log, params)
+    counts = [0, 0, 0, 0, 0]
+    records = sorted(log.room_predictions, key=lambda r: r.t)
+    times = np.array([r.t for r in records])
+    for t_lost in follow_metrics(log, params).loss_times:
+        k = int(np.searchsorted(times, t_lost + _EPS, side="right")) - 1
+        if k < 0:
+            continue
+        rec = records[k]
+        at = rec.t + rec.horizon_s
+        if len(a.t) == 0 or at > a.t[-1] + _EPS:
+            continue
+        i = min(int(np.searchsorted(a.t, at - _EPS)), len(a.t) - 1)
+        xy = a.target_true_xy[i]
+        if np.isnan(xy[0]):
+            continue
+        truth = regions.locate(xy)
+        if truth is None:
+            continue
+        base = [r for r in (rec.heading, rec.current) if r is not None]
+        counts[0] += 1
+        counts[1] += rec.ranked[:1] == (truth,)
+        counts[2] += truth in rec.ranked[:2]
+        counts[3] += base[:1] == [truth]
+        counts[4] += truth in base[:2]
+    return RoomPredictionScores(*counts)

@@ -287,6 +287,8 @@ class SearchConfig(CoreSection, core=SearchParams):
     heading_window_s: FromCore
     min_frontier_cells: FromCore
     waypoint_choice: FromCore
+    strategy: FromCore
+    look_s: FromCore
 
 
 class ControlConfig(

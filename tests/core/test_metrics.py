@@ -360,3 +360,32 @@ def test_runs() -> None:
     assert starts.tolist() == [0, 3, 6] and ends.tolist() == [1, 3, 8]
     starts, ends = runs(np.zeros(0, dtype=bool))
     assert len(starts) == len(ends) == 0
+
+
+def test_room_prediction_is_scored_at_the_loss_against_where_she_is_later() -> None:
+    from pfctl.core.episode import RoomPredictionRecord
+    from pfctl.core.mapping.house import HouseLayout, Region
+    from pfctl.core.mapping.regions import RegionMap
+    from pfctl.core.metrics import RoomPredictionScores, room_prediction_scores
+
+    # alice walks from x = 1 to x = 6 along +x; "near" is x < 3, "far" beyond
+    regions = RegionMap(
+        HouseLayout(
+            regions=(
+                Region("near", ((-1, -1), (3, -1), (3, 1), (-1, 1))),
+                Region("far", ((3, -1), (9, -1), (9, 1), (3, 1))),
+            )
+        )
+    )
+    log = make_log("V" * 10 + "L" * 50, distance=list(np.linspace(1.0, 6.0, 60)))
+    # at the loss (t = 1.0 s, x ≈ 1.8) the belief says "far" then "near"; l* is None, her room
+    # "near"; 3 s later she is at x ≈ 4.4: in "far"
+    log.room_predictions.append(RoomPredictionRecord(1.0, ("far", "near"), None, "near", 3.0))
+    scores = room_prediction_scores(log, regions)
+    assert scores == RoomPredictionScores(scored=1, top1=1, top2=1, heading_top1=0, heading_top2=0)
+    # with l* "far" the baseline hits too
+    log.room_predictions[0] = RoomPredictionRecord(1.0, ("near", "far"), "far", "near", 3.0)
+    assert room_prediction_scores(log, regions) == RoomPredictionScores(1, 0, 1, 1, 1)
+    # a horizon past the end of the episode is not scored
+    log.room_predictions[0] = RoomPredictionRecord(1.0, ("far",), "far", "near", 30.0)
+    assert room_prediction_scores(log, regions).scored == 0

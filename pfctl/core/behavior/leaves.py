@@ -32,6 +32,7 @@ from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.regions import WaypointDecision
 from pfctl.core.perception.viewpoints import nearest_viewpoint
+from pfctl.core.search.next_look import Look, rank_looks
 
 
 class Leaf(py_trees.behaviour.Behaviour):
@@ -344,10 +345,28 @@ class WaypointSearch(Action):
     #: A new decision keeps the current way-point if a goal lies this close to it, metres.
     KEEP_RADIUS: ClassVar[float] = 0.6
 
+    #: A new look replaces the one under way only when it scores this much better.
+    SWITCH_GAIN: ClassVar[float] = 1.3
+    #: A place the robot could not drive to (a person in the door, say) is tried again after
+    #: this long, s: a likely room is not given up for good.
+    RETRY_S: ClassVar[float] = 10.0
+    #: Looks inside one room (at its parts not seen yet) before the rest counts as unseeable.
+    INSIDE_LOOKS: ClassVar[int] = 3
+    #: Head sweep to either side of the room's bearing while looking, rad.
+    LOOK_PAN: ClassVar[float] = 0.9
+
     def initialise(self) -> None:
         self._decision: WaypointDecision | None = None
         self._decided_at = -math.inf
         self._visited: list[tuple[float, float]] = []
+        self._look: Look | None = None
+        self._look_chosen_at = -math.inf
+        self._looking_since: float | None = None
+        self._from_door: set[str] = set()
+        self._failed: set[tuple[str, str]] = set()
+        self._unreachable: dict[tuple[str, str], float] = {}
+        """Looks the robot could not drive to, and when: skipped for ``RETRY_S``."""
+        self._inside: dict[str, int] = {}
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
         return all(math.dist(goal, v) >= self.VISITED_RADIUS for v in self._visited)
@@ -422,6 +441,10 @@ class WaypointSearch(Action):
     def act(self) -> Status:
         if self.visible():
             return Status.SUCCESS
+        if self.world.search.strategy == "belief" and self.world.whereabouts is not None:
+            status = self._act_belief()
+            if status is not None:
+                return status
         decision = self._decision
         if decision is None or self.t - self._decided_at >= self.REPLAN_S:
             decision = self._decide()
@@ -438,6 +461,87 @@ class WaypointSearch(Action):
             return Status.FAILURE
         if self.intents.go_to(decision.waypoint, self.params["tolerance"]) != "running":
             self.intents.turn(self.intents.control.max_angular_speed * 0.5)
+        return Status.RUNNING
+
+    # -- strategy "belief": where she can be, the next place by P / (t_drive + t_look) ----------
+
+    def _choose(self) -> Look | None:
+        pose = self.bb.pose
+        p = self.prediction
+        if p is not None and p.reached and p.region is not None:
+            self._from_door.add(p.region)  # go_to_prediction went to its doorway and looked
+        control = self.intents.control
+        looks = rank_looks(
+            self.world.whereabouts,  # type: ignore[arg-type]
+            self.t,
+            (pose.x, pose.y),
+            robot_speed=control.max_linear_speed,
+            look_s=self.world.search.look_s,
+            looked_from_door=self._from_door,
+            skip=self._failed
+            | {k for k, at in self._unreachable.items() if self.t - at < self.RETRY_S},
+        )
+        self._look_chosen_at = self.t
+        current = self._look
+        if not looks:
+            return None
+        best = looks[0]
+        if current is not None and self._looking_since is None:
+            same = next(
+                (lk for lk in looks if (lk.region, lk.kind) == (current.region, current.kind)),
+                None,
+            )
+            if same is not None and best.score < self.SWITCH_GAIN * same.score:
+                best = same
+        return best
+
+    def _act_belief(self) -> Status | None:
+        """One tick of the belief search: drive to the chosen place, then sweep the head over
+        the room from there for ``search.look_s``; then choose again. None when the belief has
+        no place left to look (the caller falls back to Algorithm 1's frontiers)."""
+        look = self._look
+        if look is None or (
+            self._looking_since is None and self.t - self._look_chosen_at >= self.REPLAN_S
+        ):
+            look = self._choose()
+            if look is None:
+                self._look = None
+                return None
+            if look != self._look:
+                self._looking_since = None
+            self._look = look
+        if self._looking_since is None:
+            outcome = self.intents.go_to(look.viewpoint, self.params["tolerance"])
+            if outcome == "running":
+                self.intents.look_at(look.look_at, "sweep")
+                return Status.RUNNING
+            if outcome == "failed":
+                self._unreachable[(look.region, look.kind)] = self.t
+                self._look = None
+                self.intents.stop()
+                return Status.RUNNING
+            self._looking_since = self.t
+        elapsed = self.t - self._looking_since
+        seconds = self.world.search.look_s
+        if elapsed >= seconds:
+            if look.kind == "doorway":
+                self._from_door.add(look.region)
+            else:
+                self._inside[look.region] = self._inside.get(look.region, 0) + 1
+                if self._inside[look.region] >= self.INSIDE_LOOKS:
+                    self._failed.add((look.region, "inside"))  # the rest cannot be seen
+            self._look, self._looking_since = None, None
+            self._look_chosen_at = -math.inf
+            self.intents.stop()
+            return Status.RUNNING
+        pose = self.bb.pose
+        bearing = math.atan2(look.look_at[1] - pose.y, look.look_at[0] - pose.x) - pose.theta
+        bearing = math.atan2(math.sin(bearing), math.cos(bearing))
+        if abs(bearing) > self.LOOK_PAN:
+            self.intents.turn(math.copysign(0.5 * self.intents.control.max_angular_speed, bearing))
+        else:
+            self.intents.stop()
+        self.intents.set_pan(bearing + sweep_pan(elapsed, seconds, self.LOOK_PAN), 0.0, "sweep")
         return Status.RUNNING
 
 

@@ -2,8 +2,9 @@
 
 A :class:`WorldModel` sits on the blackboard (key ``world``). It holds the robot's occupancy grid
 (Eq. 1: it starts unknown and fills in as the laser sees the house), the static map's planner
-(walls and furniture inflated by the robot's radius), the region map of Algorithm 1, and, per
-tick, the other people the tracker holds and the stamp of the newest laser scan. The follower's
+(walls and furniture inflated by the robot's radius), the region map of Algorithm 1, the
+belief over where a lost target can be (:class:`~pfctl.core.search.whereabouts.Whereabouts`), and,
+per tick, the other people the tracker holds and the stamp of the newest laser scan. The follower's
 perceive stage keeps it up to date; leaves read it to run their control laws (the base's
 line-of-sight check, Algorithm 1) and never write it.
 """
@@ -16,6 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, waypoint_search
+from pfctl.core.search.whereabouts import Whereabouts
 
 #: Cells at least this likely occupied block the line of sight (the grid's occupied threshold).
 _OCCUPIED_LOGODDS = float(logit(OCCUPIED_THRESH))
@@ -30,6 +32,7 @@ class WorldModel:
         planner: GridPlanner,
         regions: RegionMap,
         search: SearchParams,
+        whereabouts: Whereabouts | None = None,
     ) -> None:
         self.grid = grid
         """The robot's occupancy grid (Eq. 1), updated with every scan."""
@@ -37,6 +40,8 @@ class WorldModel:
         """The static map's planner: where the robot can be (:meth:`free_goal`)."""
         self.regions = regions
         self.search = search
+        self.whereabouts = whereabouts
+        """Where the lost target can be (None: not kept); the follower feeds it."""
         self.sensor_stamp: float | None = None
         """Stamp of the newest laser scan, s (None before the first)."""
         self.people_xy: NDArray[np.float64] = np.empty((0, 2))

@@ -51,9 +51,11 @@ if TYPE_CHECKING:
 
 
 __all__ = [
+    "SEARCH_STRATEGIES",
     "WAYPOINT_CHOICES",
     "RegionMap",
     "SearchParams",
+    "SearchStrategy",
     "WaypointChoice",
     "WaypointDecision",
     "heading_region",
@@ -269,6 +271,10 @@ WaypointChoice = Literal["utility", "nearest"]
 """How Algorithm 1 picks among the frontier clusters (:func:`waypoint_search`)."""
 WAYPOINT_CHOICES: tuple[WaypointChoice, ...] = ("utility", "nearest")
 
+SearchStrategy = Literal["belief", "paper"]
+"""How the lost target is looked for (:class:`SearchParams.strategy`)."""
+SEARCH_STRATEGIES: tuple[SearchStrategy, ...] = ("belief", "paper")
+
 
 @dataclass(frozen=True)
 class SearchParams:
@@ -286,6 +292,20 @@ class SearchParams:
         "How Algorithm 1 picks the frontier to search: ``utility`` (Eq. 3, the paper) or"
         " ``nearest`` (the reachable frontier nearest the robot by path length, whatever its size"
         " or l*: the nearest-frontier baseline, ``missions/baselines/``).",
+    )
+    strategy: SearchStrategy = param(
+        "belief",
+        "How the lost target is looked for: ``belief`` (where she can be, spread along the"
+        " doors since she was last seen and emptied where the camera looked; the next place is"
+        " the most probable room over the time to get there and look, from its doorway first;"
+        " the prediction goes to the predicted room) or ``paper`` (the paper literally: the"
+        " prediction's end point, then Algorithm 1's way-points; ``missions/baselines/``).",
+    )
+    look_s: float = param(
+        6.0,
+        "How long the head sweeps a room from a place to look (strategy belief).",
+        unit="s",
+        gt=0,
     )
 
 

@@ -30,6 +30,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from pfctl.core.episode import TrackRow
 from pfctl.core.perception.belief import HumanBelief
@@ -88,6 +89,9 @@ class Perception:
         self.last_sightings: tuple[CameraSighting, ...] = ()
         self._camera_people: tuple[float, np.ndarray] | None = None
         """The latest frame's stamp and the floor positions ``(n, 2)`` of its people."""
+        self.last_visible: NDArray[np.bool_] | None = None
+        """The belief grid's cells the last frame saw (Eq. 4's visible mask; None without a
+        belief or a frame yet)."""
 
     def on_scan(self, scan: LaserScan) -> LegDetections:
         """Detect legs in ``scan`` and update the tracks with the person candidates."""
@@ -124,7 +128,9 @@ class Perception:
             for person, track_id in zip(people, ids, strict=True)
         ]
         if self.belief is not None:
-            self.belief.update(fov, [d.position[:2] for d in people], frame.stamp)
+            self.last_visible = self.belief.update(
+                fov, [d.position[:2] for d in people], frame.stamp
+            )
         self.last_sightings = tuple(sightings)
         return self.last_sightings
 

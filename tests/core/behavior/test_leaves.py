@@ -143,6 +143,54 @@ def test_waypoint_search_explores_toward_the_heading_region(empty_house: Mission
     assert follower.regions.locate((end.x, end.y)) in {"hall", "office"}
 
 
+def _with_strategy(mission: Mission, strategy: str) -> Mission:
+    search = mission.search.model_copy(update={"strategy": strategy})
+    return mission.model_copy(update={"search": search})
+
+
+def _lost_walking_to_the_office(follower: Follower) -> None:
+    """The target was last seen at t = 0 walking up the hall toward the office door."""
+    t = np.linspace(-3.0, 0.0, 31)
+    path = np.column_stack([t, np.full_like(t, 3.9), 5.7 + 0.4 * t])
+    seen = Sighting(0.0, (3.9, 5.7), path)
+    follower._last_seen = seen
+    follower._lost(0.0, seen)
+
+
+def test_belief_search_looks_into_the_likely_room_from_its_doorway(empty_house: Mission) -> None:
+    tree = {"action": "waypoint_search"}
+    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
+        follower = _follower(empty_house, robot, tree)
+        _lost_walking_to_the_office(follower)
+        assert follower.log.room_predictions[-1].ranked[0] == "office"
+        assert follower.log.room_predictions[-1].heading == "office"
+        records = _run(follower, robot, 30.0)
+        follower.close()
+    assert all(r.action == "waypoint_search" and r.awareness == "searching" for r in records)
+    # from the kitchen it looks into the hall from its door (she was there at the loss), then
+    # drives to the office doorway and stands there sweeping the head: no tour of other rooms
+    office_door = (3.95, 6.0)
+    goals = [r.goal for r in records if r.goal is not None]
+    assert any(math.dist(g, office_door) < 0.3 for g in goals)
+    looks = [r for r in records if r.base_mode != "move_base"]
+    assert sum(r.gaze == "sweep" for r in looks) >= len(looks) - 3  # a look's last tick: none
+    assert any(math.dist((r.pose.x, r.pose.y), office_door) < 0.6 for r in looks)
+    rooms = {follower.regions.locate((r.pose.x, r.pose.y)) for r in records}
+    assert rooms <= {"kitchen", "hall", "office"}
+    assert follower.log.waypoints == []  # Algorithm 1 was not needed
+
+
+def test_the_paper_strategy_keeps_algorithm_1(empty_house: Mission) -> None:
+    mission = _with_strategy(empty_house, "paper")
+    with SimRobot(sim_config(mission), SimOptions(camera=False)) as robot:
+        follower = _follower(mission, robot, {"action": "waypoint_search"})
+        _lost_walking_to_the_office(follower)
+        _run(follower, robot, 5.0)
+        follower.close()
+    waypoints = follower.log.waypoints
+    assert waypoints and {w.heading_region for w in waypoints} == {"office"}
+
+
 def _leaf_with_pose(pose: Pose2D) -> WaypointSearch:
     namespace = new_namespace()
     writer = py_trees.blackboard.Client(name="test", namespace=namespace)
