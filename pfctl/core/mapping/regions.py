@@ -294,12 +294,12 @@ class SearchParams:
         " or l*: the nearest-frontier baseline, ``missions/baselines/``).",
     )
     strategy: SearchStrategy = param(
-        "belief",
-        "How the lost target is looked for: ``belief`` (where she can be, spread along the"
+        "paper",
+        "How the lost target is looked for: ``paper`` (the paper literally: the prediction's end"
+        " point, then Algorithm 1's way-points) or ``belief`` (where she can be, spread along the"
         " doors since she was last seen and emptied where the camera looked; the next place is"
         " the most probable room over the time to get there and look, from its doorway first;"
-        " the prediction goes to the predicted room) or ``paper`` (the paper literally: the"
-        " prediction's end point, then Algorithm 1's way-points; ``missions/baselines/``).",
+        " the prediction goes to the predicted room; ``missions/house_belief_search.yaml``).",
     )
     look_s: float = param(
         6.0,

@@ -159,8 +159,9 @@ def _lost_walking_to_the_office(follower: Follower) -> None:
 
 def test_belief_search_looks_into_the_likely_room_from_its_doorway(empty_house: Mission) -> None:
     tree = {"action": "waypoint_search"}
-    with SimRobot(sim_config(empty_house), SimOptions(camera=False)) as robot:
-        follower = _follower(empty_house, robot, tree)
+    mission = _with_strategy(empty_house, "belief")
+    with SimRobot(sim_config(mission), SimOptions(camera=False)) as robot:
+        follower = _follower(mission, robot, tree)
         _lost_walking_to_the_office(follower)
         assert follower.log.room_predictions[-1].ranked[0] == "office"
         assert follower.log.room_predictions[-1].heading == "office"
