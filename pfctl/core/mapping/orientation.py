@@ -94,10 +94,10 @@ def rotated_map(
     res = geometry.resolution
     x0, x1, y0, y1 = geometry.extent
     corners = rotate_points(np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]]), angle)
-    ox = math.floor(corners[:, 0].min() / res) * res
-    oy = math.floor(corners[:, 1].min() / res) * res
-    width = math.ceil(corners[:, 0].max() / res) - round(ox / res)
-    height = math.ceil(corners[:, 1].max() / res) - round(oy / res)
+    lo = np.floor(corners.min(axis=0) / res + 1e-9).astype(int)  # rounding off a turned corner
+    hi = np.ceil(corners.max(axis=0) / res - 1e-9).astype(int)
+    ox, oy = round(float(lo[0] * res), 9) + 0.0, round(float(lo[1] * res), 9) + 0.0
+    width, height = int(hi[0] - lo[0]), int(hi[1] - lo[1])
     new = GridGeometry(resolution=res, width=int(width), height=int(height), origin=(ox, oy))
     centres = new.cell_to_world(*np.indices(new.shape))
     rows, cols = geometry.world_to_cell(rotate_points(centres, -angle))
