@@ -7,6 +7,12 @@ Bormann et al. (2016), "Room segmentation: survey, implementation, and analysis"
 is kept as ``method="distance"`` (it cuts at every narrow place, furniture gaps included, and
 cannot tell a 1.2 m corridor from a 1.4 m door). Both share the watershed growth step:
 
+A SLAM map is usually turned by some angle from the grid (its frame is where the mapping
+started); ``walls`` looks for wall lines along rows and columns, so :func:`segment_free_space`
+first turns the map until its dominant wall orientation is axis-aligned, segments it there and
+turns the rooms and doors back; a map with no dominant wall orientation is segmented with
+``distance`` instead, with a warning.
+
 0. **Clean-up.** Non-free specks smaller than ``noise_area`` inside the free space (laser
    noise, unknown pinholes of a SLAM map) count as free.
 1. **Cores.**
