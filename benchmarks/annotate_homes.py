@@ -1,10 +1,13 @@
 """`pfctl map annotate --auto` on generated homes: rooms and doors found against the truth.
 
 Run ``python benchmarks/annotate_homes.py [--homes 50] [--first-seed 1] [--noise/--no-noise]
-[--door-width W]``. For each seed it generates the home ``pfctl mission generate --seed N`` would
-write, exports its map as ``pfctl map export`` does (walls, doors, furniture; map_server YAML +
-PGM, read back), optionally adds SLAM-like noise (:mod:`pfctl.core.mapping.noise`, seeded by the
-home's seed), proposes rooms and doors as ``pfctl map annotate --auto`` does, and scores them:
+[--door-width W] [--rotate DEG|random]``. For each seed it generates the home ``pfctl mission
+generate --seed N`` would write, exports its map as ``pfctl map export`` does (walls, doors,
+furniture; map_server YAML + PGM, read back), optionally turns it by an angle as a SLAM map of
+the home would be (the occupancy image resampled nearest-neighbour, unknown outside; the true
+rooms and doors turned with it; ``random``: an angle in [0°, 90°) drawn from the home's seed),
+optionally adds SLAM-like noise (:mod:`pfctl.core.mapping.noise`, seeded by the home's seed),
+proposes rooms and doors as ``pfctl map annotate --auto`` does, and scores them:
 
 - rooms: true regions (corridor and hall included) matched one-to-one by a proposed room with
   polygon IoU ≥ 0.7, % of the true regions;
@@ -20,6 +23,7 @@ Maps and grids only: no simulation, a few seconds per home.
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import tempfile
 import time
@@ -32,8 +36,9 @@ from shapely.geometry import LineString
 from pfctl.app.homes import make_home
 from pfctl.commands.map import auto_layout
 from pfctl.core.homes.home import HomeOptions
-from pfctl.core.mapping.house import Door, HouseLayout
+from pfctl.core.mapping.house import Door, HouseLayout, Region
 from pfctl.core.mapping.noise import slam_noise
+from pfctl.core.mapping.orientation import rotate_points, rotated_map
 from pfctl.core.mapping.rooms import RoomParams, match_regions, segment_free_space
 from pfctl.core.mapping.walls import rasterize_house
 from pfctl.errors import UserError
@@ -101,6 +106,18 @@ def exported_states(truth: HouseLayout, resolution: float, wall_thickness: float
     return loaded.states(), loaded.geometry
 
 
+def rotated_layout(layout: HouseLayout, angle: float) -> HouseLayout:
+    """The rooms and doors turned counter-clockwise by ``angle`` radians about the origin."""
+
+    def turn(points) -> tuple[tuple[float, float], ...]:
+        return tuple((float(x), float(y)) for x, y in rotate_points(np.asarray(points), angle))
+
+    return HouseLayout(
+        regions=tuple(Region(r.name, turn(r.polygon)) for r in layout.regions),
+        doors=tuple(Door(d.between, turn(d.segment)) for d in layout.doors),  # type: ignore[arg-type]
+    )
+
+
 def run_one(
     truth: HouseLayout,
     resolution: float,
@@ -108,8 +125,13 @@ def run_one(
     noise_seed: int | None,
     params: RoomParams,
     tmp: Path,
+    rotate_deg: float = 0.0,
 ) -> Score:
     states, geometry = exported_states(truth, resolution, wall_thickness, tmp)
+    truth = HouseLayout(regions=truth.regions, doors=truth.doors)
+    if rotate_deg:
+        states, geometry = rotated_map(states, geometry, math.radians(rotate_deg))
+        truth = rotated_layout(truth, math.radians(rotate_deg))
     if noise_seed is not None:
         states = slam_noise(states, resolution, np.random.default_rng([noise_seed, 25]))
     try:
@@ -119,10 +141,10 @@ def run_one(
             raw = segment_free_space(states, geometry, params).layout()
         except ValueError:
             raw = HouseLayout(regions=(), doors=())
-        s = score(HouseLayout(regions=truth.regions, doors=truth.doors), raw)
+        s = score(truth, raw)
         s.failed = str(err)
         return s
-    s = score(HouseLayout(regions=truth.regions, doors=truth.doors), layout)
+    s = score(truth, layout)
     s.warnings = len(warnings)
     return s
 
@@ -137,7 +159,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--first-seed", type=int, default=1)
     ap.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True)
     ap.add_argument("--door-width", type=float, default=None)
+    ap.add_argument(
+        "--rotate",
+        default="0",
+        help="turn each exported map by DEG degrees, or by a seeded random angle ('random')",
+    )
     args = ap.parse_args(argv)
+    if args.rotate != "random":
+        try:
+            float(args.rotate)
+        except ValueError:
+            ap.error(f"--rotate: expected degrees or 'random', got {args.rotate!r}")
     params = RoomParams() if args.door_width is None else RoomParams(door_width=args.door_width)
     t0 = time.monotonic()
     total = Score(0, 0, 0, 0, 0, 0)
@@ -157,6 +189,11 @@ def main(argv: list[str] | None = None) -> int:
         for seed in range(args.first_seed, args.first_seed + args.homes):
             gen = make_home(HomeOptions(seed=seed))
             m = gen.mission
+            deg = (
+                float(np.random.default_rng([seed, 90]).uniform(0.0, 90.0))
+                if args.rotate == "random"
+                else float(args.rotate)
+            )
             s = run_one(
                 m.layout(),
                 m.map.resolution,
@@ -164,6 +201,7 @@ def main(argv: list[str] | None = None) -> int:
                 seed if args.noise else None,
                 params,
                 tmp,
+                deg,
             )
             for name in ("regions", "rooms_matched", "proposed_rooms", "doors", "doors_found"):
                 setattr(total, name, getattr(total, name) + getattr(s, name))
@@ -173,7 +211,8 @@ def main(argv: list[str] | None = None) -> int:
             warned += bool(s.warnings)
             if s.failed or s.rooms_matched < s.regions or s.doors_found < s.doors or s.spurious:
                 print(
-                    f"seed {seed:3d} {gen.home.plan.kind:9s}: rooms {s.rooms_matched}/{s.regions}"
+                    f"seed {seed:3d} {gen.home.plan.kind:9s} {deg:5.1f}°: "
+                    f"rooms {s.rooms_matched}/{s.regions}"
                     f" (proposed {s.proposed_rooms}), doors {s.doors_found}/{s.doors}"
                     f" (proposed {s.proposed_doors})"
                     + (f"  FAILED: {s.failed[:90]}" if s.failed else "")
@@ -181,7 +220,8 @@ def main(argv: list[str] | None = None) -> int:
     print()
     print(
         f"{args.homes} homes (seeds {args.first_seed}..{args.first_seed + args.homes - 1}), "
-        f"noise {'on' if args.noise else 'off'}, door_width {params.door_width:g} m, "
+        f"noise {'on' if args.noise else 'off'}, rotate {args.rotate}, "
+        f"door_width {params.door_width:g} m, "
         f"{time.monotonic() - t0:.0f} s"
     )
     print(

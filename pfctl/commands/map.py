@@ -281,7 +281,7 @@ def auto_layout(
     layout = seg.layout()
     try:
         check_layout(layout.regions, layout.doors, geometry.resolution)
-        return layout, []
+        return layout, [f"--auto: {w}" for w in seg.warnings]
     except UserError:
         pass
     # a proposed door the mission rules reject is dropped, not the whole proposal
@@ -294,7 +294,7 @@ def auto_layout(
             kept.append(d)
         except UserError:
             dropped.append(f"{d.between[0]}|{d.between[1]}")
-    warnings = [
+    warnings = [f"--auto: {w}" for w in seg.warnings] + [
         f"--auto: dropped {len(dropped)} proposed door(s) not on the wall their rooms share: "
         + ", ".join(dropped)
     ]

@@ -346,3 +346,74 @@ def test_auto_drops_a_door_off_the_shared_wall_with_one_warning(
     written = load_mission(out).layout()
     assert len(written.regions) == 5 and len(written.doors) == 5
     assert "wrote" in stdout
+
+
+def _save_states(states: np.ndarray, geometry, path: Path) -> Path:
+    """A trinary map written as map_server YAML + PGM, as a SLAM package's map_saver would."""
+    from pfctl.core.mapping.grid import FREE, OCCUPIED, OccupancyGrid
+    from pfctl.mission.map_server import save_map_server
+
+    p = np.where(states == FREE, 0.0, np.where(states == OCCUPIED, 1.0, 0.5))
+    grid = OccupancyGrid.from_probabilities(p, geometry.resolution, origin=geometry.origin)
+    return save_map_server(grid, path)[0]
+
+
+def test_auto_annotation_of_the_house_turned_by_17_degrees_finds_every_room(
+    monkeypatch, capsys, house_map, tmp_path
+) -> None:
+    """A SLAM map is turned by wherever the mapping started: the exported house turned by 17°
+    still gives its 5 rooms and 5 doors, turned with it, with no warning."""
+    import math
+
+    from pfctl.core.mapping.orientation import rotate_points, rotated_map
+
+    angle = math.radians(17.0)
+    loaded = load_map_server(house_map)
+    states, geometry = rotated_map(loaded.states(), loaded.geometry, angle)
+    turned_map = _save_states(states, geometry, tmp_path / "turned.yaml")
+    out = tmp_path / "m.yaml"
+    code, _, err = cli(monkeypatch, capsys, "map", "annotate", turned_map, "--auto", "--out", out)
+    assert code == 0 and err == "", err
+    written = load_mission(out).layout()
+    truth = load_mission(HOUSE).layout()
+    for region in truth.regions:
+        turned = Polygon(rotate_points(np.asarray(region.polygon), angle))
+        ious = [polygon_iou(Polygon(p.polygon), turned) for p in written.regions]
+        assert sum(iou >= 0.8 for iou in ious) == 1, (region.name, ious)
+    assert len(written.regions) == 5 and len(written.doors) == 5
+
+
+def test_auto_on_walls_in_no_dominant_direction_warns_once_and_writes(
+    monkeypatch, capsys, tmp_path
+) -> None:
+    """Two hexagonal rooms: no wall angle to segment at, so the distance transform does it, with
+    one warning line; exit 0 and the mission written."""
+    import math
+
+    def hexagon(cx: float, cy: float) -> tuple[tuple[float, float], ...]:
+        return tuple(
+            (
+                round(cx + 3 * math.cos(k * math.pi / 3), 6),
+                round(cy + 3 * math.sin(k * math.pi / 3), 6),
+            )
+            for k in range(6)
+        )
+
+    from pfctl.core.mapping.house import HouseLayout
+
+    door = ((2.5, round(math.sqrt(3) / 2, 6)), (2.0, round(math.sqrt(3), 6)))
+    layout = HouseLayout(
+        regions=(Region("a", hexagon(0, 0)), Region("b", hexagon(4.5, 1.5 * math.sqrt(3)))),
+        doors=(Door(("a", "b"), door),),
+    )
+    grid = rasterize_house(layout, 0.05)
+    hex_map = _save_states(grid.states(), grid.geometry, tmp_path / "hex.yaml")
+    out = tmp_path / "m.yaml"
+    code, stdout, err = cli(monkeypatch, capsys, "map", "annotate", hex_map, "--auto", "--out", out)
+    assert code == 0, err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("pfctl: warning: "), err
+    assert "no dominant direction" in lines[0] and "distance transform" in lines[0]
+    written = load_mission(out).layout()
+    assert len(written.regions) == 2 and len(written.doors) == 1
+    assert "wrote" in stdout

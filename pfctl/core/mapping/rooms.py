@@ -7,6 +7,12 @@ Bormann et al. (2016), "Room segmentation: survey, implementation, and analysis"
 is kept as ``method="distance"`` (it cuts at every narrow place, furniture gaps included, and
 cannot tell a 1.2 m corridor from a 1.4 m door). Both share the watershed growth step:
 
+A SLAM map is usually turned by some angle from the grid (its frame is where the mapping
+started); ``walls`` looks for wall lines along rows and columns, so :func:`segment_free_space`
+first turns the map until its dominant wall orientation is axis-aligned, segments it there and
+turns the rooms and doors back; a map with no dominant wall orientation is segmented with
+``distance`` instead, with a warning.
+
 0. **Clean-up.** Non-free specks smaller than ``noise_area`` inside the free space (laser
    noise, unknown pinholes of a SLAM map) count as free.
 1. **Cores.**
@@ -62,6 +68,7 @@ from shapely.ops import substring, unary_union
 
 from pfctl.core.mapping.grid import FREE, OCCUPIED, GridGeometry
 from pfctl.core.mapping.house import Door, HouseLayout, Region
+from pfctl.core.mapping.orientation import rotate_points, rotated_map, wall_orientation
 
 XY = tuple[float, float]
 
@@ -94,6 +101,13 @@ class RoomParams:
             free space count as free: speckle, pinholes, chair legs (0.1 m²; 0 = off).
         min_door_width: touching stretches narrower than this are not proposed as doors (0.3 m).
         name_row_height: centroid rows for the deterministic ``room_N`` order (1.0 m).
+        align_walls: ``walls``: turn the map so its walls are axis-aligned before looking for
+            wall lines, and the rooms and doors back (a SLAM map is rotated by wherever the
+            mapping started); see :func:`segment_free_space`.
+        min_manhattan: ``walls``: the least strength of the dominant wall orientation
+            (:func:`~pfctl.core.mapping.orientation.wall_orientation`, 0–1) for the walls
+            method; below it the walls run in too many directions and ``distance`` is used (0.35;
+            Manhattan homes measure ~0.7).
     """
 
     door_width: float = 3.2
@@ -108,6 +122,8 @@ class RoomParams:
     noise_area: float = 0.1
     min_door_width: float = 0.3
     name_row_height: float = 1.0
+    align_walls: bool = True
+    min_manhattan: float = 0.35
 
 
 @dataclass(frozen=True)
@@ -148,6 +164,9 @@ class RoomSegmentation:
         rooms: the rooms, in name order.
         doors: the proposed doors, sorted by the names they join.
         core_radius: the distance-transform threshold that was used, metres.
+        wall_angle: the angle (radians, counter-clockwise) the walls were turned from the grid
+            axes and segmented at; 0 if they were segmented as they are.
+        warnings: one line each about how the map was segmented (e.g. a fallback method).
     """
 
     labels: NDArray[np.int32]
@@ -155,6 +174,8 @@ class RoomSegmentation:
     rooms: tuple[ProposedRoom, ...]
     doors: tuple[ProposedDoor, ...] = field(default=())
     core_radius: float = 0.0
+    wall_angle: float = 0.0
+    warnings: tuple[str, ...] = ()
 
     def layout(self) -> HouseLayout:
         """The rooms and doors as a :class:`HouseLayout` (no obstacles)."""
@@ -581,6 +602,13 @@ def _order(polygons: dict[int, Polygon], row_height: float) -> list[int]:
 # public API
 
 
+#: Walls turned less than this from the grid axes are segmented as they are (radians).
+_ALIGNED = math.radians(0.2)
+#: The largest ``door_width`` of the ``distance`` fallback: its cores need rooms wider than
+#: ``door_width + 2·resolution``, and the walls method's 3.2 m would leave most rooms without one.
+_FALLBACK_DOOR_WIDTH = 1.0
+
+
 def segment_free_space(
     states: NDArray[np.integer],
     geometry: GridGeometry,
@@ -588,14 +616,139 @@ def segment_free_space(
 ) -> RoomSegmentation:
     """Segment a trinary map (:data:`FREE`/:data:`OCCUPIED`/:data:`UNKNOWN` per cell) into rooms.
 
-    See the module docstring for the method. Raises ``ValueError`` if no room is found (no free
-    core wider than ``2·core_radius``).
+    See the module docstring for the method. With ``walls`` (and ``align_walls``), the map's
+    dominant wall orientation is estimated first
+    (:func:`~pfctl.core.mapping.orientation.wall_orientation`): walls turned from the grid axes
+    are turned back (the map resampled, :func:`~pfctl.core.mapping.orientation.rotated_map`),
+    segmented there, and the rooms, doors and labels turned into the map frame again; a map whose
+    walls have no dominant orientation (strength below ``min_manhattan``) is segmented with
+    ``distance`` (``door_width`` at most 1 m) and one warning in ``warnings``. Raises
+    ``ValueError`` if no room is found (no free core wider than ``2·core_radius``).
     """
     params = params or RoomParams()
-    res = geometry.resolution
     states = np.asarray(states)
     if states.shape != geometry.shape:
         raise ValueError(f"states of shape {states.shape} do not match the grid {geometry.shape}")
+    if params.method != "walls" or not params.align_walls:
+        return _segment(states, geometry, params)
+    angle, strength = wall_orientation(states == OCCUPIED)
+    if strength < params.min_manhattan:
+        fallback = replace(
+            params, method="distance", door_width=min(params.door_width, _FALLBACK_DOOR_WIDTH)
+        )
+        warning = (
+            f"the walls run in no dominant direction (strength {strength:.2f} < "
+            f"{params.min_manhattan:g}): rooms by the distance transform, door width "
+            f"{fallback.door_width:g} m"
+        )
+        return replace(_segment(states, geometry, fallback), warnings=(warning,))
+    if abs(angle) < _ALIGNED:
+        return _segment(states, geometry, params)
+    turned, turned_geometry = rotated_map(states, geometry, -angle)
+    turned = _fill_pinholes(turned)
+    # resampled walls are a cell thicker across at each step of their staircase
+    thicker = replace(params, wall_thickness=params.wall_thickness + geometry.resolution)
+    return _turned_back(_segment(turned, turned_geometry, thicker), geometry, angle, params)
+
+
+def _turned_back(
+    seg: RoomSegmentation, geometry: GridGeometry, angle: float, params: RoomParams
+) -> RoomSegmentation:
+    """A segmentation made on the map turned by ``-angle``, turned by ``angle`` into the map
+    frame of ``geometry``: polygons and doors turned and rounded to the grid as
+    :func:`_ring` does (a door's ends stay vertices of both its rooms), labels sampled at each
+    map cell's centre, rooms renamed in map-frame order."""
+    res = geometry.resolution
+    digits = max(3, -math.floor(math.log10(res)) + 1) if res < 1 else 3
+
+    def turn(points: tuple[XY, ...]) -> list[XY]:
+        out = rotate_points(np.asarray(points, dtype=np.float64), angle)
+        return [(round(float(x), digits) + 0.0, round(float(y), digits) + 0.0) for x, y in out]
+
+    polygons: dict[int, Polygon] = {}
+    rings: dict[int, tuple[XY, ...]] = {}
+    shared = _shared_vertices({room.label: room.polygon for room in seg.rooms})
+    for room in seg.rooms:
+        pts = turn(shared[room.label])
+        start = min(range(len(pts)), key=lambda i: (pts[i][1], pts[i][0]))
+        rings[room.label] = tuple(pts[start:] + pts[:start])
+        polygons[room.label] = Polygon(rings[room.label])
+    order = _order(polygons, params.name_row_height)
+    names = {lab: f"room_{i}" for i, lab in enumerate(order, start=1)}
+    label_of = {room.name: room.label for room in seg.rooms}
+    doors = []
+    for d in seg.doors:
+        a, b = turn(d.segment)
+        la, lb = (label_of[n] for n in d.between)
+        pair = tuple(sorted((names[la], names[lb])))
+        doors.append(ProposedDoor(between=pair, segment=(a, b) if a <= b else (b, a)))  # type: ignore[arg-type]
+    centres = geometry.cell_to_world(*np.indices(geometry.shape))
+    rows, cols = seg.geometry.world_to_cell(rotate_points(centres, -angle))
+    inside = seg.geometry.in_bounds(rows, cols)
+    labels = np.zeros(geometry.shape, dtype=np.int32)
+    labels[inside] = seg.labels[rows[inside], cols[inside]]
+    rooms = tuple(
+        ProposedRoom(
+            label=lab,
+            name=names[lab],
+            polygon=rings[lab],
+            area=round(float(polygons[lab].area), 3),
+        )
+        for lab in order
+    )
+    return replace(
+        seg,
+        labels=labels,
+        geometry=geometry,
+        rooms=rooms,
+        doors=tuple(sorted(doors, key=lambda d: (d.between, d.segment))),
+        wall_angle=angle,
+    )
+
+
+def _fill_pinholes(states: NDArray[np.integer]) -> NDArray[np.integer]:
+    """``states`` with every non-occupied cell between two occupied ones (west and east, or south
+    and north) occupied: the one-cell holes that resampling a turned map punches into its walls
+    (they cut a wall line's jamb short). No opening is that narrow (``min_door_width``)."""
+    occ = states == OCCUPIED
+    pad = np.pad(occ, 1, constant_values=False)
+    between = (pad[1:-1, :-2] & pad[1:-1, 2:]) | (pad[:-2, 1:-1] & pad[2:, 1:-1])
+    out = states.copy()
+    out[between & ~occ] = OCCUPIED
+    return out
+
+
+def _shared_vertices(rings: dict[int, tuple[XY, ...]]) -> dict[int, tuple[XY, ...]]:
+    """Each ring with every vertex of another ring that lies on one of its edges (a T-junction)
+    inserted as a vertex, so that after turning and rounding, neighbours still meet exactly."""
+    out = dict(rings)
+    for lab in rings:
+        boundary = Polygon(rings[lab]).exterior
+        own = set(rings[lab])
+        extra = [
+            p
+            for other, ring in rings.items()
+            if other != lab
+            for p in ring
+            if p not in own and boundary.distance(Point(p)) <= 1e-9
+        ]
+        for p in dict.fromkeys(extra):
+            pts = list(out[lab])
+            n = len(pts)
+            i = min(
+                range(n),
+                key=lambda i: LineString([pts[i], pts[(i + 1) % n]]).distance(Point(p)),
+            )
+            pts.insert(i + 1, p)
+            out[lab] = tuple(pts)
+    return out
+
+
+def _segment(
+    states: NDArray[np.integer], geometry: GridGeometry, params: RoomParams
+) -> RoomSegmentation:
+    """:func:`segment_free_space` on the map as it is (no turning)."""
+    res = geometry.resolution
     free = states == FREE
     occupied = states == OCCUPIED
     if params.noise_area > 0:

@@ -14,6 +14,7 @@ from pfctl.core.homes.home import HomeOptions, generate_home
 from pfctl.core.mapping.grid import FREE, OCCUPIED, UNKNOWN, GridGeometry
 from pfctl.core.mapping.house import Door, HouseLayout, Obstacle, Region
 from pfctl.core.mapping.noise import slam_noise
+from pfctl.core.mapping.orientation import rotate_points, rotated_map
 from pfctl.core.mapping.rooms import (
     RoomParams,
     match_regions,
@@ -197,6 +198,77 @@ def test_a_generated_home_is_segmented_into_its_rooms_and_doors(seed: int, noise
     found = _doors_found(truth.doors, proposal.doors)
     assert found >= 0.9 * len(truth.doors)
     assert len(proposal.doors) - found == 0
+
+
+def _turned(layout: HouseLayout, angle: float) -> HouseLayout:
+    """The regions and doors of ``layout`` turned by ``angle`` radians about the origin."""
+
+    def turn(points) -> tuple[tuple[float, float], ...]:
+        return tuple((float(x), float(y)) for x, y in rotate_points(np.asarray(points), angle))
+
+    return HouseLayout(
+        regions=tuple(Region(r.name, turn(r.polygon)) for r in layout.regions),
+        doors=tuple(Door(d.between, turn(d.segment)) for d in layout.doors),  # type: ignore[arg-type]
+    )
+
+
+@pytest.mark.parametrize("degrees", [17.0, 33.0])
+@pytest.mark.parametrize("seed", [1, 2, 7])  # corridor, open plan, hall
+def test_a_turned_generated_home_is_segmented_into_its_rooms_and_doors(
+    seed: int, degrees: float
+) -> None:
+    """A SLAM map is turned by wherever the mapping started: the exported map turned by
+    ``degrees`` (and the truth with it), with SLAM noise, is segmented at its wall angle into its
+    true rooms (IoU ≥ 0.7) and ≥ 90 % of its doors, in the map's own frame and grid; the rooms
+    still tile without overlap and each door's ends are vertices of both its rooms."""
+    angle = math.radians(degrees)
+    layout = _generated(seed)
+    grid = rasterize_house(layout, 0.05, wall_thickness=0.1)
+    states, geometry = rotated_map(grid.states(), grid.geometry, angle)
+    states = slam_noise(states, 0.05, np.random.default_rng([seed, 25]))
+    truth = _turned(layout, angle)
+    seg = segment_free_space(states, geometry)
+    assert abs(math.degrees(seg.wall_angle) - degrees) <= 1.0
+    assert seg.labels.shape == geometry.shape and seg.warnings == ()
+    proposal = seg.layout()
+    matches = match_regions(proposal.regions, truth.regions, min_iou=0.7)
+    assert len(matches) == len(truth.regions) == len(proposal.regions)
+    found = _doors_found(truth.doors, proposal.doors)
+    assert found >= 0.9 * len(truth.doors)
+    assert len(proposal.doors) - found <= 0.05 * len(proposal.doors)
+    shapes = {r.name: Polygon(r.polygon) for r in proposal.regions}
+    for a in shapes:
+        for b in shapes:
+            if a < b:
+                assert shapes[a].intersection(shapes[b]).area <= 1e-6
+    for d in proposal.doors:
+        for name in d.between:
+            assert set(d.segment) <= set(seg.room(name).polygon)
+
+
+def _hexagon(cx: float, cy: float, r: float = 3.0) -> tuple[tuple[float, float], ...]:
+    return tuple(
+        (
+            round(cx + r * math.cos(math.radians(60 * k)), 6),
+            round(cy + r * math.sin(math.radians(60 * k)), 6),
+        )
+        for k in range(6)
+    )
+
+
+def test_walls_in_no_dominant_direction_fall_back_to_the_distance_method() -> None:
+    """Two hexagonal rooms (walls at 0°, 60° and 120°) and a 1 m door between them: no wall
+    angle to turn to, so the distance transform segments them, with one warning saying so."""
+    door = ((2.5, round(math.sqrt(3) / 2, 6)), (2.0, round(math.sqrt(3), 6)))
+    layout = HouseLayout(
+        regions=(Region("a", _hexagon(0, 0)), Region("b", _hexagon(4.5, 1.5 * math.sqrt(3)))),
+        doors=(Door(("a", "b"), door),),
+    )
+    seg = segment_rooms(rasterize_house(layout, 0.05))
+    assert len(seg.warnings) == 1 and "distance transform" in seg.warnings[0]
+    assert len(match_regions(seg.layout().regions, layout.regions, min_iou=0.9)) == 2
+    assert len(seg.doors) == 1 and seg.wall_angle == 0.0
+    assert segment_rooms(rasterize_house(_two_rooms(0.9), 0.05)).warnings == ()
 
 
 def test_a_gap_between_two_pieces_of_furniture_is_not_a_door() -> None:
