@@ -366,7 +366,10 @@ def test_navigate_through_move_base(ros_master, ros_nodes):
     second = driver.event("second")
     assert driver.finish() == 0
     assert second["same"] is True and second["beams"] == N_BEAMS
-    assert seen == ["idle", "pending", "active", "preempted", "succeeded"]
+    # right after navigate() the goal is pending, or already active when move_base's acceptance
+    # arrived first (a busy machine can deschedule the driver between the two calls)
+    assert seen[0] == "idle" and seen[1] in ("pending", "active")
+    assert seen[2:] == ["active", "preempted", "succeeded"]
     goals = [s.split() for s in fake.lines if s.startswith("GOAL")]
     assert [g[0] for g in goals] == ["GOAL", "GOAL_END", "GOAL", "GOAL_END"]
     assert goals[1][2] == "preempted" and goals[3][2] == "succeeded"
