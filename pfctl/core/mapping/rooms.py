@@ -588,6 +588,24 @@ def _doors(
     return doors
 
 
+def _proposed_rooms(
+    order: list[int],
+    names: dict[int, str],
+    rings: dict[int, tuple[XY, ...]],
+    polygons: dict[int, Polygon],
+) -> tuple[ProposedRoom, ...]:
+    """The rooms in ``order``: each label's name, outline (``rings``) and area (m², mm)."""
+    return tuple(
+        ProposedRoom(
+            label=lab,
+            name=names[lab],
+            polygon=rings[lab],
+            area=round(float(polygons[lab].area), 3),
+        )
+        for lab in order
+    )
+
+
 def _order(polygons: dict[int, Polygon], row_height: float) -> list[int]:
     """Labels sorted by centroid: rows of ``row_height`` m south to north, then west to east."""
 
@@ -687,15 +705,7 @@ def _turned_back(
     inside = seg.geometry.in_bounds(rows, cols)
     labels = np.zeros(geometry.shape, dtype=np.int32)
     labels[inside] = seg.labels[rows[inside], cols[inside]]
-    rooms = tuple(
-        ProposedRoom(
-            label=lab,
-            name=names[lab],
-            polygon=rings[lab],
-            area=round(float(polygons[lab].area), 3),
-        )
-        for lab in order
-    )
+    rooms = _proposed_rooms(order, names, rings, polygons)
     return replace(
         seg,
         labels=labels,
@@ -800,15 +810,7 @@ def _segment(
     for (a, b), seg in found:  # door ends as vertices of both rooms: exactly on their wall
         rings[a] = _with_vertices(rings[a], seg, res)
         rings[b] = _with_vertices(rings[b], seg, res)
-    rooms = tuple(
-        ProposedRoom(
-            label=lab,
-            name=names[lab],
-            polygon=rings[lab],
-            area=round(float(polygons[lab].area), 3),
-        )
-        for lab in order
-    )
+    rooms = _proposed_rooms(order, names, rings, polygons)
     doors = tuple(
         sorted(
             (ProposedDoor(between=(names[a], names[b]), segment=seg) for (a, b), seg in found),
