@@ -592,8 +592,11 @@ class OracleSearch(Action):
     (:func:`~pfctl.core.perception.viewpoints.nearest_viewpoint`: free for the robot, within
     ``range`` of her, no wall or furniture between), re-planned every ``REPLAN_S`` seconds as
     she walks, the head on her true position; its time to re-find is the floor a search can be
-    compared against. RUNNING until the target is detected (SUCCESS); FAILURE without the truth
-    or when no such place can be reached."""
+    compared against. A line of sight that only just clears a door jamb shows the camera too
+    little of her to detect: when the robot has stood at the place for ``settle`` seconds
+    without seeing her, the line's clearance grows by ``CLEARANCE_STEP`` (up to
+    ``MAX_CLEARANCE``) and the place is chosen again. RUNNING until the target is detected
+    (SUCCESS); FAILURE without the truth or when no such place can be reached."""
 
     spec = LeafSpec(
         "oracle_search",
@@ -615,15 +618,41 @@ class OracleSearch(Action):
                 minimum=0.0,
             ),
             param("tolerance", 0.3, "arrival distance at the place, m", minimum=0.05),
+            param(
+                "settle",
+                2.0,
+                "seconds at the place with her unseen before a clearer line of sight is sought",
+                minimum=0.1,
+            ),
         ),
     )
     reads = (*Leaf.reads, "true_target")
 
     REPLAN_S: ClassVar[float] = 1.0
+    CLEARANCE_STEP: ClassVar[float] = 0.25
+    MAX_CLEARANCE: ClassVar[float] = 1.0
 
     def initialise(self) -> None:
         self._goal: tuple[float, float] | None = None
         self._decided_at = -math.inf
+        self._extra_clearance = 0.0
+        self._arrived_at: float | None = None
+
+    def _place(self, truth: tuple[float, float]) -> tuple[float, float] | None:
+        """The nearest place with her in sight at the current clearance; at the mission's own
+        clearance when no place has the larger one."""
+        pose = self.bb.pose
+        reach = self.params["range"]
+        hi = math.inf if reach is None else float(reach)
+        lo = min(float(self.params["range_min"]), hi / 2)
+        base = float(self.params["clearance"])
+        for clearance in dict.fromkeys((base + self._extra_clearance, base)):
+            place = nearest_viewpoint(
+                self.world.planner, (pose.x, pose.y), truth, hi, lo, clearance
+            )
+            if place is not None:
+                return place.xy
+        return None
 
     def act(self) -> Status:
         if self.visible():
@@ -632,27 +661,27 @@ class OracleSearch(Action):
         if truth is None:
             return Status.FAILURE
         if self._goal is None or self.t - self._decided_at >= self.REPLAN_S:
-            pose = self.bb.pose
-            reach = self.params["range"]
-            hi = math.inf if reach is None else float(reach)
-            lo = float(self.params["range_min"])
-            place = nearest_viewpoint(
-                self.world.planner,
-                (pose.x, pose.y),
-                truth,
-                hi,
-                min(lo, hi / 2),
-                float(self.params["clearance"]),
-            )
             self._decided_at = self.t
-            self._goal = None if place is None else place.xy
+            self._goal = self._place(truth)
         self.intents.look_at(truth, "oracle")
         if self._goal is None:
             self.intents.stop()
             return Status.FAILURE
-        if self.intents.go_to(self._goal, self.params["tolerance"]) == "failed":
+        outcome = self.intents.go_to(self._goal, self.params["tolerance"])
+        if outcome == "failed":
             self._goal = None
             return Status.FAILURE
+        if outcome != "arrived":
+            self._arrived_at = None
+        elif self._arrived_at is None:
+            self._arrived_at = self.t
+        elif self.t - self._arrived_at >= self.params["settle"]:
+            base = float(self.params["clearance"])
+            self._extra_clearance = min(
+                self._extra_clearance + self.CLEARANCE_STEP, max(0.0, self.MAX_CLEARANCE - base)
+            )
+            self._arrived_at = None
+            self._decided_at = -math.inf  # choose the place again on the next tick
         return Status.RUNNING
 
 

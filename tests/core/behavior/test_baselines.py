@@ -371,3 +371,28 @@ def test_the_oracle_drives_to_the_nearest_place_that_sees_her_and_replans_as_she
     assert again is not None and again.xy != want.xy and ("go_to", again.xy) in rig.intents.calls
     # seen: follow again
     assert rig.tick(3.0, _target(3.0), seen, here) == (Status.RUNNING, "follow_target")
+
+
+def test_the_oracle_asks_for_a_clearer_sight_when_she_stays_unseen_at_the_place() -> None:
+    """A line that just clears a jamb shows the camera too little of her: after ``settle`` s
+    at the place without seeing her, the place is chosen again with 0.25 m more clearance."""
+    rig = TreeRig("oracle.yaml")
+    planner = _two_rooms()
+    rig.bb.world = SimpleNamespace(planner=planner)
+    here = Pose2D(1.0, 3.0)
+    rig.tick(0.0, _target(0.0), pose=here)
+    seen = Sighting(0.0, (2.0, 1.0), np.array([[0.0, 2.0, 1.0]]))
+    her = (6.0, 3.0)
+    rig.bb.true_target = her
+    assert rig.tick(1.0, None, seen, here) == (Status.RUNNING, "oracle_search")
+    first = nearest_viewpoint(planner, (here.x, here.y), her, 5.0, 0.6, 0.25)
+    clearer = nearest_viewpoint(planner, (here.x, here.y), her, 5.0, 0.6, 0.5)
+    assert first is not None and clearer is not None and clearer.xy != first.xy
+    rig.intents.nav = "arrived"  # at the place, and still she is not detected
+    for now in (1.2, 2.2, 3.1):  # less than settle (2 s) since the arrival at 1.2 s
+        rig.tick(now, None, seen, here)
+    assert {xy for kind, xy in rig.intents.calls if kind == "go_to"} == {first.xy}
+    rig.intents.kinds()
+    rig.tick(3.2, None, seen, here)  # 2 s at the place: ask for more clearance
+    rig.tick(3.3, None, seen, here)
+    assert ("go_to", clearer.xy) in rig.intents.calls
