@@ -1,0 +1,174 @@
+"""``pfctl track evaluate``: the replay's perception on every scan of a bag, scored by CLEAR-MOT
+against the bag's annotated people.
+
+The bag is replayed as ``pfctl replay`` does (:func:`~pfctl.bags.replay.open_replay`: scans
+posed in a fixed frame through the bag's tf; leg detection and tracking of the mission's
+perception). After each scan the tracks the replay reports (confirmed and seen now: the rows of
+``tracks.csv``) are brought into the laser's frame at that scan's stamp — where the annotations
+are (:mod:`pfctl.bags.annotations`) — and each annotated scan (the scan nearest the
+annotation's bag time, within half a scan period) is scored by
+:class:`~pfctl.core.perception.clear_mot.ClearMot`.
+
+For rate checks the scans can be thinned (``decimate``: every n-th scan) and each kept scan
+repeated ``spread`` times with its stamps spread evenly up to the next kept scan (the same
+motion seen at ``spread`` times the rate); a scan is scored at its first copy, and only the
+annotations of kept scans count.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, nullcontext
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from pfctl.app.perception import build_perception
+from pfctl.bags.annotations import AnnotatedPeople, nearest_scan, read_annotations
+from pfctl.bags.replay import open_replay
+from pfctl.core.perception.clear_mot import ClearMot, ClearMotResult, FrameScore
+from pfctl.core.perception.pipeline import Perception
+from pfctl.core.robot import LaserScan
+from pfctl.errors import UserError
+from pfctl.mission import Mission, load_mission
+
+Progress = Callable[[int], AbstractContextManager[Callable[[int], None]]]
+"""A progress bar up to a total, yielding ``advance(k)``."""
+
+
+@dataclass(frozen=True)
+class ScanTracks:
+    """The tracks reported after one scan, in the laser's frame at its stamp."""
+
+    stamp: float
+    ids: tuple[int, ...]
+    xy: np.ndarray
+
+
+@dataclass(frozen=True)
+class TrackEvaluation:
+    """What :func:`evaluate_tracks` measured."""
+
+    result: ClearMotResult
+    frames: tuple[FrameScore, ...]
+    """One per annotated scan, in time order."""
+    truth: tuple[AnnotatedPeople, ...]
+    """The annotations scored, each stamped with its scan's stamp."""
+    tracks: tuple[ScanTracks, ...]
+    """The tracks after every scan (laser frame)."""
+    frame: str
+    """The fixed frame the tracker ran in."""
+    scan_topic: str
+    unpaired: int
+    """Annotated scans with no scan near their time (not scored)."""
+    skipped: dict[str, int]
+
+
+def _thinned(
+    scans: Iterator[LaserScan | None], decimate: int, spread: int
+) -> Iterator[tuple[LaserScan, bool]]:
+    """Every ``decimate``-th scan, each followed by ``spread − 1`` copies stamped evenly up to
+    the next one; ``(scan, is_first_copy)``."""
+    kept = (s for k, s in enumerate(s for s in scans if s is not None) if k % decimate == 0)
+    previous: LaserScan | None = None
+    for scan in kept:
+        if previous is not None:
+            yield previous, True
+            step = (scan.stamp - previous.stamp) / spread
+            for k in range(1, spread):
+                yield replace(previous, stamp=previous.stamp + k * step), False
+        previous = scan
+    if previous is not None:
+        yield previous, True
+
+
+def _seen_tracks(perception: Perception, scan: LaserScan) -> ScanTracks:
+    rows = perception.seen_track_rows(scan.stamp)
+    xy = np.array([(r[2], r[3]) for r in rows], dtype=float).reshape(-1, 2)
+    local = scan.pose.inverse().transform(xy) if len(xy) else xy
+    return ScanTracks(scan.stamp, tuple(r[1] for r in rows), local)
+
+
+def evaluation_mission(path: Path | None) -> Mission:
+    """The mission whose perception parameters to use; without one, every default (a
+    placeholder map: the evaluation does not use it)."""
+    if path is None:
+        placeholder = {"name": "all", "polygon": [[0, 0], [1, 0], [1, 1], [0, 1]]}
+        return Mission.model_validate({"name": "track", "map": {"regions": [placeholder]}})
+    if not path.is_file():
+        raise UserError(f"--mission {path}: no such mission file")
+    return load_mission(path)
+
+
+def evaluate_tracks(
+    bag_path: Path,
+    ground_truth: str,
+    mission: Mission,
+    *,
+    scan_topic: str | None = None,
+    frame: str | None = None,
+    radius: float = 0.75,
+    decimate: int = 1,
+    spread: int = 1,
+    progress: Progress | None = None,
+) -> TrackEvaluation:
+    """Replay ``bag_path``'s scans through the mission's perception and score the tracks by
+    CLEAR-MOT at the scans annotated on ``ground_truth`` (module docstring). One-line
+    :class:`~pfctl.errors.UserError` for a bag without the topics or frames asked."""
+    if not radius > 0:
+        raise UserError(f"--radius: expected a distance > 0 m, got {radius:g}")
+    source = open_replay(bag_path, scan_topic=scan_topic, frame=frame, camera=False)
+    with source.bag:
+        annotations = read_annotations(source.bag, ground_truth)
+        perception = build_perception(mission)
+        seen: list[ScanTracks] = []
+        native: list[float] = []
+        bar = nullcontext(None) if progress is None else progress(source.total())
+        with bar as advance:
+            counted = (_count(item, native, advance) for item in source.stream())
+            for scan, first in _thinned(counted, decimate, spread):
+                perception.on_scan(scan)
+                if first:
+                    seen.append(_seen_tracks(perception, scan))
+    if not seen:
+        raise UserError(f"{bag_path}: no scan of {source.scan_topic} could be posed")
+    stamps = [s.stamp for s in seen]
+    period = float(np.median(np.diff(native))) if len(native) > 1 else 0.0
+    mot = ClearMot(radius)
+    truth: list[AnnotatedPeople] = []
+    unpaired = 0
+    for people in annotations:
+        i = nearest_scan(stamps, people.time, 0.5 * period)
+        if i is None:
+            unpaired += 1
+            continue
+        tracks = seen[i]
+        mot.add(tracks.stamp, people.ids, people.xy, tracks.ids, tracks.xy)
+        truth.append(replace(people, time=tracks.stamp))
+    return TrackEvaluation(
+        mot.result(),
+        tuple(mot.frames),
+        tuple(truth),
+        tuple(seen),
+        source.frame,
+        source.scan_topic,
+        unpaired,
+        dict(source.skipped),
+    )
+
+
+def _count(
+    item: object, stamps: list[float], advance: Callable[[int], None] | None
+) -> LaserScan | None:
+    """``item`` if it is a scan (its stamp appended to ``stamps``), else None; one step of the
+    progress bar either way."""
+    if advance is not None:
+        advance(1)
+    if not isinstance(item, LaserScan):
+        return None
+    stamps.append(item.stamp)
+    return item
+
+
+__all__ = ["Progress", "ScanTracks", "TrackEvaluation", "evaluate_tracks", "evaluation_mission"]
