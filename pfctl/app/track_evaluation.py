@@ -17,7 +17,7 @@ annotations of kept scans count.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -65,12 +65,14 @@ class TrackEvaluation:
     skipped: dict[str, int]
 
 
-def _thinned(
-    scans: Iterator[LaserScan | None], decimate: int, spread: int
+def thinned(
+    scans: Iterable[LaserScan], decimate: int, spread: int
 ) -> Iterator[tuple[LaserScan, bool]]:
     """Every ``decimate``-th scan, each followed by ``spread − 1`` copies stamped evenly up to
     the next one; ``(scan, is_first_copy)``."""
-    kept = (s for k, s in enumerate(s for s in scans if s is not None) if k % decimate == 0)
+    if decimate < 1 or spread < 1:
+        raise ValueError(f"decimate and spread must be ≥ 1, got {decimate} and {spread}")
+    kept = (s for k, s in enumerate(scans) if k % decimate == 0)
     previous: LaserScan | None = None
     for scan in kept:
         if previous is not None:
@@ -122,17 +124,38 @@ def evaluate_tracks(
     with source.bag:
         annotations = read_annotations(source.bag, ground_truth)
         perception = build_perception(mission)
-        seen: list[ScanTracks] = []
-        native: list[float] = []
         bar = nullcontext(None) if progress is None else progress(source.total())
         with bar as advance:
-            counted = (_count(item, native, advance) for item in source.stream())
-            for scan, first in _thinned(counted, decimate, spread):
-                perception.on_scan(scan)
-                if first:
-                    seen.append(_seen_tracks(perception, scan))
-    if not seen:
+            scans = (
+                s for s in (_count(item, advance) for item in source.stream()) if s is not None
+            )
+            scored = score_scans(
+                scans, annotations, perception, radius=radius, decimate=decimate, spread=spread
+            )
+    if not scored.tracks:
         raise UserError(f"{bag_path}: no scan of {source.scan_topic} could be posed")
+    return replace(
+        scored, frame=source.frame, scan_topic=source.scan_topic, skipped=dict(source.skipped)
+    )
+
+
+def score_scans(
+    scans: Iterable[LaserScan],
+    annotations: Sequence[AnnotatedPeople],
+    perception: Perception,
+    *,
+    radius: float = 0.75,
+    decimate: int = 1,
+    spread: int = 1,
+) -> TrackEvaluation:
+    """Run ``perception`` on ``scans`` (posed in a fixed frame, in time order), thinned and
+    spread as asked, and score its tracks at the annotated scans (module docstring)."""
+    native: list[float] = []
+    seen: list[ScanTracks] = []
+    for scan, first in thinned(_stamped(scans, native), decimate, spread):
+        perception.on_scan(scan)
+        if first:
+            seen.append(_seen_tracks(perception, scan))
     stamps = [s.stamp for s in seen]
     period = float(np.median(np.diff(native))) if len(native) > 1 else 0.0
     mot = ClearMot(radius)
@@ -147,28 +170,30 @@ def evaluate_tracks(
         mot.add(tracks.stamp, people.ids, people.xy, tracks.ids, tracks.xy)
         truth.append(replace(people, time=tracks.stamp))
     return TrackEvaluation(
-        mot.result(),
-        tuple(mot.frames),
-        tuple(truth),
-        tuple(seen),
-        source.frame,
-        source.scan_topic,
-        unpaired,
-        dict(source.skipped),
+        mot.result(), tuple(mot.frames), tuple(truth), tuple(seen), "", "", unpaired, {}
     )
 
 
-def _count(
-    item: object, stamps: list[float], advance: Callable[[int], None] | None
-) -> LaserScan | None:
-    """``item`` if it is a scan (its stamp appended to ``stamps``), else None; one step of the
-    progress bar either way."""
+def _stamped(scans: Iterable[LaserScan], stamps: list[float]) -> Iterator[LaserScan]:
+    """``scans``, each one's stamp appended to ``stamps`` as it passes."""
+    for scan in scans:
+        stamps.append(scan.stamp)
+        yield scan
+
+
+def _count(item: object, advance: Callable[[int], None] | None) -> LaserScan | None:
+    """``item`` if it is a scan, else None; one step of the progress bar either way."""
     if advance is not None:
         advance(1)
-    if not isinstance(item, LaserScan):
-        return None
-    stamps.append(item.stamp)
-    return item
+    return item if isinstance(item, LaserScan) else None
 
 
-__all__ = ["Progress", "ScanTracks", "TrackEvaluation", "evaluate_tracks", "evaluation_mission"]
+__all__ = [
+    "Progress",
+    "ScanTracks",
+    "TrackEvaluation",
+    "evaluate_tracks",
+    "evaluation_mission",
+    "score_scans",
+    "thinned",
+]
