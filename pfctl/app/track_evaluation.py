@@ -5,9 +5,8 @@ The bag is replayed as ``pfctl replay`` does (:func:`~pfctl.bags.replay.open_rep
 posed in a fixed frame through the bag's tf; leg detection and tracking of the mission's
 perception). After each scan the tracks the replay reports (confirmed and seen now: the rows of
 ``tracks.csv``) are brought into the laser's frame at that scan's stamp — where the annotations
-are (:mod:`pfctl.bags.annotations`) — and each annotated scan (the scan nearest the
-annotation's bag time, within half a scan period) is scored by
-:class:`~pfctl.core.perception.clear_mot.ClearMot`.
+are (:mod:`pfctl.bags.annotations`) — and each annotated scan (the last scan recorded before the
+annotation) is scored by :class:`~pfctl.core.perception.clear_mot.ClearMot`.
 
 For rate checks the scans can be thinned (``decimate``: every n-th scan) and each kept scan
 repeated ``spread`` times with its stamps spread evenly up to the next kept scan (the same
@@ -32,6 +31,9 @@ from pfctl.core.perception.pipeline import Perception
 from pfctl.core.robot import LaserScan
 from pfctl.errors import UserError
 from pfctl.mission import Mission, load_mission
+
+#: Stamps closer than this (s) are the same scan's.
+SAME_STAMP_S = 1e-6
 
 Progress = Callable[[int], AbstractContextManager[Callable[[int], None]]]
 """A progress bar up to a total, yielding ``advance(k)``."""
@@ -61,7 +63,7 @@ class TrackEvaluation:
     """The fixed frame the tracker ran in."""
     scan_topic: str
     unpaired: int
-    """Annotated scans with no scan near their time (not scored)."""
+    """Annotated scans that were not replayed (not posed, or thinned out): not scored."""
     skipped: dict[str, int]
 
 
@@ -122,7 +124,7 @@ def evaluate_tracks(
         raise UserError(f"--radius: expected a distance > 0 m, got {radius:g}")
     source = open_replay(bag_path, scan_topic=scan_topic, frame=frame, camera=False)
     with source.bag:
-        annotations = read_annotations(source.bag, ground_truth)
+        annotations = read_annotations(source.bag, ground_truth, source.scan_topic)
         perception = build_perception(mission)
         bar = nullcontext(None) if progress is None else progress(source.total())
         with bar as advance:
@@ -150,19 +152,21 @@ def score_scans(
 ) -> TrackEvaluation:
     """Run ``perception`` on ``scans`` (posed in a fixed frame, in time order), thinned and
     spread as asked, and score its tracks at the annotated scans (module docstring)."""
-    native: list[float] = []
     seen: list[ScanTracks] = []
-    for scan, first in thinned(_stamped(scans, native), decimate, spread):
+    for scan, first in thinned(scans, decimate, spread):
         perception.on_scan(scan)
         if first:
             seen.append(_seen_tracks(perception, scan))
     stamps = [s.stamp for s in seen]
-    period = float(np.median(np.diff(native))) if len(native) > 1 else 0.0
     mot = ClearMot(radius)
     truth: list[AnnotatedPeople] = []
     unpaired = 0
     for people in annotations:
-        i = nearest_scan(stamps, people.time, 0.5 * period)
+        i = (
+            None
+            if people.scan_stamp is None
+            else nearest_scan(stamps, people.scan_stamp, SAME_STAMP_S)
+        )
         if i is None:
             unpaired += 1
             continue
@@ -172,13 +176,6 @@ def score_scans(
     return TrackEvaluation(
         mot.result(), tuple(mot.frames), tuple(truth), tuple(seen), "", "", unpaired, {}
     )
-
-
-def _stamped(scans: Iterable[LaserScan], stamps: list[float]) -> Iterator[LaserScan]:
-    """``scans``, each one's stamp appended to ``stamps`` as it passes."""
-    for scan in scans:
-        stamps.append(scan.stamp)
-        yield scan
 
 
 def _count(item: object, advance: Callable[[int], None] | None) -> LaserScan | None:

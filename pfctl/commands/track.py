@@ -128,7 +128,8 @@ def evaluate(
     )
     if ev.unpaired:
         print(
-            f"note: {ev.unpaired} annotated scans have no scan within half a period: not scored",
+            f"note: {ev.unpaired} annotated scans were not replayed (not posed, or thinned out): "
+            "not scored",
             file=sys.stderr,
         )
     for reason, count in sorted(ev.skipped.items()):

@@ -35,7 +35,7 @@ def annotated() -> tuple[list[LaserScan], list[AnnotatedPeople]]:
         pytest.skip(f"{BAG} is absent (the shared real leg data)")
     source = open_replay(BAG, scan_topic="/scan", frame="odom", camera=False)
     with source.bag:
-        annotations = read_annotations(source.bag, GROUND_TRUTH)
+        annotations = read_annotations(source.bag, GROUND_TRUTH, source.scan_topic)
         scans = [s for s in source.stream() if isinstance(s, LaserScan)]
     return scans, annotations
 
