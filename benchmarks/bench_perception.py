@@ -4,9 +4,9 @@ Run ``python benchmarks/bench_perception.py [--runs N]``. It feeds the 1081-beam
 ``bench_legs.py`` (10 people 1–5 m ahead) to
 :meth:`pfctl.core.perception.pipeline.Perception.on_scan` at 40 Hz stamps — leg detection with the
 shipped model, then the tracker's predict, Hungarian association and Kalman updates — and prints the
-median, 90th and 99th percentiles in milliseconds after the ten tracks are confirmed. Goal (issue 5): under
-3 ms a scan. The belief update is timed by ``bench_tracking_belief.py``. It asserts nothing about
-time.
+median, 90th and 99th percentiles in milliseconds after the ten tracks are confirmed. Goal (issue
+5): under 3 ms a scan. The belief update is timed by ``bench_tracking_belief.py``. It asserts
+nothing about time.
 """
 
 from __future__ import annotations
