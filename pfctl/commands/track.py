@@ -41,7 +41,7 @@ def _metrics(bag: Path, ground_truth: str, radius: float, ev: TrackEvaluation) -
     r = ev.result
     return {
         "bag": str(bag),
-        "ground_truth": ground_truth,
+        "ground_truth_topic": ground_truth,
         "scan_topic": ev.scan_topic,
         "frame": ev.frame,
         "radius": radius,

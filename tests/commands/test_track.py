@@ -39,6 +39,7 @@ def test_evaluate_scores_the_annotated_scans_and_writes_metrics_and_a_picture(
     assert "MOTA 0.0 %" in stdout and "misses 4" in stdout and "ID switches 0" in stdout
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["ground_truth"] == 4 and metrics["misses"] == 4
+    assert metrics["ground_truth_topic"] == PEOPLE and metrics["scans"] == 10
     assert metrics["frames"] == 3 and metrics["false_positives"] == 0
     assert metrics["mota"] == 0.0 and metrics["motp"] is None  # no match: no mean distance
     assert (out / "tracks.png").read_bytes()[:4] == b"\x89PNG"
