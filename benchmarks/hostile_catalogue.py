@@ -1214,6 +1214,53 @@ def _learn_replay_cases() -> list[Case]:
             needs=("bag",),
         ),
     ]
+    te, gt = "track evaluate", "/ground_truth_people_tracks"
+    c += [
+        _err("te-missing", te, ["gone.bag", "--ground-truth", gt, "--out", "o"], ["gone.bag"]),
+        _err(
+            "te-random-bag",
+            te,
+            ["r.bag", "--ground-truth", gt, "--out", "o"],
+            ["r.bag"],
+            {"r.bag": random_bytes(20000)},
+        ),
+        _err("te-no-ground-truth", te, ["{bag}", "--out", "o"], ["--ground-truth"], needs=("bag",)),
+        _err(
+            "te-ground-truth-missing",
+            te,
+            ["{bag}", "--ground-truth", gt, "--out", "o"],
+            [gt],
+            needs=("bag",),
+        ),
+        _err(
+            "te-ground-truth-wrong-type",
+            te,
+            ["{bag}", "--ground-truth", "/hsrb/base_scan", "--out", "o"],
+            ["/hsrb/base_scan", "leg_tracker/Person"],
+            needs=("bag",),
+        ),
+        _err(
+            "te-radius-zero",
+            te,
+            ["{bag}", "--ground-truth", gt, "--radius", "0", "--out", "o"],
+            ["--radius"],
+            needs=("bag",),
+        ),
+        _err(
+            "te-radius-nan",
+            te,
+            ["{bag}", "--ground-truth", gt, "--radius", "nan", "--out", "o"],
+            ["--radius"],
+            needs=("bag",),
+        ),
+        _err(
+            "te-decimate-zero",
+            te,
+            ["{bag}", "--ground-truth", gt, "--decimate", "0", "--out", "o"],
+            ["--decimate"],
+            needs=("bag",),
+        ),
+    ]
     return c
 
 
@@ -1804,6 +1851,7 @@ COMMANDS = (
     "search",
     "learn-target",
     "replay",
+    "track evaluate",
     "bench",
     "predict",
     "predict evaluate",

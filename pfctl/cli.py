@@ -23,6 +23,7 @@ from pfctl.commands import mission as mission_commands
 from pfctl.commands import predict as predict_commands
 from pfctl.commands import replay as replay_command
 from pfctl.commands import sim as sim_commands
+from pfctl.commands import track as track_commands
 from pfctl.errors import UserError
 from pfctl.interrupts import Interrupted, command_signals, unreported
 
@@ -41,6 +42,7 @@ app.add_typer(sim_commands.app, name="sim")
 app.add_typer(predict_commands.app, name="predict")
 app.add_typer(legs_commands.app, name="legs")
 app.add_typer(bt_commands.app, name="bt")
+app.add_typer(track_commands.app, name="track")
 app.command("learn-target")(learn_target_command.learn_target)
 app.command("follow")(follow_commands.follow)
 app.command("search")(follow_commands.search)

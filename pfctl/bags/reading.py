@@ -33,6 +33,10 @@ from pfctl.errors import UserError
 
 LASER_SCAN = "sensor_msgs/msg/LaserScan"
 POSE_ARRAY = "geometry_msgs/msg/PoseArray"
+PERSON = "leg_tracker/msg/Person"
+#: ``leg_tracker/Person`` (Leigh et al.'s annotated tracks): not in the standard type stores, so
+#: registered from its definition (a bag that carries the definition gives the same type).
+PERSON_DEFINITION = "geometry_msgs/Pose pose\nuint32 id\n"
 
 
 class BagError(UserError):
@@ -102,7 +106,7 @@ class Bag:
 
     def __init__(self, path: Path) -> None:
         from rosbags.highlevel import AnyReader
-        from rosbags.typesys import Stores, get_typestore
+        from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
         self.path = Path(path)
         if not self.path.exists():
@@ -111,6 +115,7 @@ class Bag:
             raise BagError(_not_a_bag_folder(self.path))
         ros1 = self.path.is_file() and self.path.suffix == ".bag"
         store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
+        store.register(get_types_from_msg(PERSON_DEFINITION, PERSON))
         try:
             self._reader = AnyReader([self.path], default_typestore=store)
             self._reader.open()
@@ -201,6 +206,8 @@ def read_scans(path: Path, topic: str) -> list[tuple[str, LaserScan]]:
 
 __all__ = [
     "LASER_SCAN",
+    "PERSON",
+    "PERSON_DEFINITION",
     "POSE_ARRAY",
     "Bag",
     "BagError",
