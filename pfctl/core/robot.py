@@ -227,6 +227,12 @@ class Observation:
     odometry: Pose2D | None = None
     """The base's pose in the odom frame from wheel odometry (smooth, but it drifts), if any."""
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.scans, tuple):  # e.g. one scan, given where the newest was once
+            raise TypeError(
+                f"Observation.scans must be a tuple of LaserScan, got {type(self.scans).__name__}"
+            )
+
     @property
     def scan(self) -> LaserScan | None:
         """The newest of :attr:`scans`, or None if no scan has arrived since the previous
