@@ -3,10 +3,11 @@
 :meth:`Follower.tick` runs these stages in order; each is a method that can be called (and
 timed) on its own:
 
-1. :meth:`~Follower.observe` — the newest laser scan, RGB-D frame, pose and head angles, and the
-   status of the navigation goal (Robot port);
+1. :meth:`~Follower.observe` — every laser scan since the previous tick, the newest RGB-D frame,
+   pose and head angles, and the status of the navigation goal (Robot port);
 2. :meth:`~Follower.perceive` — legs + vision → tracking → identification (Algorithm 2) and the
-   human belief (Eq. 4): :class:`~pfctl.core.perception.pipeline.Perception`; the scan is fused
+   human belief (Eq. 4): :class:`~pfctl.core.perception.pipeline.Perception`, each scan at its
+   own stamp and laser pose, the frame at its stamp among them; the newest scan is fused
    into the robot's occupancy grid (Eq. 1), which starts unknown, so what the robot has not seen
    yet shows as frontiers for Algorithm 1. It gives the target's state: the identified track, if
    the tracker still has it;
@@ -86,7 +87,7 @@ from pfctl.core.mapping.regions import (
     heading_scores,
 )
 from pfctl.core.params import param
-from pfctl.core.perception.pipeline import Perception
+from pfctl.core.perception.pipeline import Perception, in_stamp_order
 from pfctl.core.prediction.clipping import clip_prediction
 from pfctl.core.prediction.models import (
     DEFAULT_MODEL,
@@ -95,7 +96,7 @@ from pfctl.core.prediction.models import (
     PredictionError,
     make_model,
 )
-from pfctl.core.robot import STOP, HeadTarget, Observation, Pose2D, Robot
+from pfctl.core.robot import STOP, HeadTarget, LaserScan, Observation, Pose2D, Robot
 from pfctl.core.search.next_look import doorway
 from pfctl.core.search.whereabouts import Whereabouts
 
@@ -220,19 +221,22 @@ class Follower:
         return obs
 
     def perceive(self, obs: Observation) -> TargetState | None:
-        """Feed the scan (then log the tracks it leaves, as ``pfctl replay`` does after each
-        scan of a bag) and the frame to the perception; update the occupancy grid (Eq. 1) and
-        the people of the world model. The target's state: its identified track, if any."""
-        scan = obs.scan
-        if scan is not None:
-            self.perception.on_scan(scan)
-            self.log.tracks += self.perception.seen_track_rows(scan.stamp)
+        """Feed every scan (then log the tracks it leaves, as ``pfctl replay`` does after each
+        scan of a bag) and the frame to the perception in the order of their stamps; update the
+        occupancy grid (Eq. 1) with the newest scan (the inverse sensor model's evidence is
+        per tick) and the people of the world model. The target's state: its identified track,
+        if any."""
         whereabouts = self.world.whereabouts
-        if obs.rgbd is not None:
-            self.perception.on_frame(obs.rgbd)
+        for message in in_stamp_order(obs):
+            if isinstance(message, LaserScan):
+                self.perception.on_scan(message)
+                self.log.tracks += self.perception.seen_track_rows(message.stamp)
+                continue
+            self.perception.on_frame(message)
             visible = self.perception.last_visible
             if whereabouts is not None and visible is not None:
-                whereabouts.observe(obs.rgbd.stamp, visible)
+                whereabouts.observe(message.stamp, visible)
+        scan = obs.scan
         if whereabouts is not None and self._last_seen is None and not whereabouts.active:
             whereabouts.never_seen(obs.stamp, (obs.pose.x, obs.pose.y))
         if scan is not None:

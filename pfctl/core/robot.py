@@ -216,14 +216,28 @@ class Observation:
     pose: Pose2D
     """The robot base's pose in the map frame (as localisation reports it; may be noisy)."""
     head: HeadState
-    scan: LaserScan | None = None
-    """The newest laser scan, or None if none has arrived since the previous observation."""
+    scans: tuple[LaserScan, ...] = ()
+    """Every laser scan since the previous observation, oldest first, stamps increasing (the
+    laser's rate, not the tick's: at 40 Hz and a 10 Hz tick, four), so that leg detection and
+    tracking run on each scan at its own stamp and pose; empty if none has arrived."""
     rgbd: RgbdFrame | None = None
     """The newest RGB-D frame, or None if none has arrived since the previous observation."""
     collisions: int = 0
     """How many collisions the base has had so far (a robot can report bumper hits)."""
     odometry: Pose2D | None = None
     """The base's pose in the odom frame from wheel odometry (smooth, but it drifts), if any."""
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.scans, tuple):  # e.g. one scan, given where the newest was once
+            raise TypeError(
+                f"Observation.scans must be a tuple of LaserScan, got {type(self.scans).__name__}"
+            )
+
+    @property
+    def scan(self) -> LaserScan | None:
+        """The newest of :attr:`scans`, or None if no scan has arrived since the previous
+        observation."""
+        return self.scans[-1] if self.scans else None
 
 
 @dataclass(frozen=True)
@@ -273,7 +287,8 @@ class Robot(Protocol):
     """The port every backend implements (DESIGN.md, "The Robot port")."""
 
     def observe(self) -> Observation:
-        """The latest sensor bundle; never ground truth."""
+        """The sensor bundle since the previous call: every scan since then, the newest RGB-D
+        frame, the pose and head now; never ground truth."""
         ...
 
     def command(self, base: Twist2D, head: HeadTarget | None = None) -> None:

@@ -33,7 +33,7 @@ def _tick(i: int) -> tuple[Observation, GroundTruth]:
     scan = LaserScan(t, -2.0, 0.01, 0.05, 20.0, np.array([1.0, np.inf, 2.5 + i]), laser)
     odom = Pose2D(0.1 * i, 0.01 * i, 0.05)  # drifted: the map pose and odometry disagree
     obs = Observation(
-        t, pose, HeadState(0.1, -0.2), scan if i % 2 == 0 else None, None, i, odometry=odom
+        t, pose, HeadState(0.1, -0.2), (scan,) if i % 2 == 0 else (), None, i, odometry=odom
     )
     people = (
         PersonTruth("alice", 3.0, 4.0 + i, 1.0, 0.8, True),

@@ -1,4 +1,5 @@
-"""The Robot port's pose algebra: composition, inverse and relative poses agree with each other."""
+"""The Robot port: its pose algebra (composition, inverse and relative poses agree with each
+other) and the observation of every scan."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from pfctl.core.robot import Pose2D, wrap_angle
+from pfctl.core.robot import HeadState, LaserScan, Observation, Pose2D, wrap_angle
 
 coord = st.floats(-50, 50, allow_nan=False)
 angle = st.floats(-10, 10, allow_nan=False)
@@ -37,3 +38,14 @@ def test_compose_moves_in_the_pose_frame_and_transform_agrees() -> None:
     assert (ahead.x, ahead.y, ahead.theta) == pytest.approx((0.9, 2.5, math.pi / 2 + 0.2))
     assert np.allclose(robot.transform([[0.5, 0.1]])[0], (ahead.x, ahead.y))
     assert wrap_angle(3 * math.pi) == pytest.approx(math.pi)
+
+
+def test_an_observation_carries_every_scan_and_its_scan_is_the_newest() -> None:
+    scans = tuple(
+        LaserScan(t, 0.0, 0.1, 0.05, 20.0, np.ones(3), Pose2D(t, 0.0)) for t in (0.025, 0.05)
+    )
+    obs = Observation(0.05, Pose2D(0.0, 0.0), HeadState(), scans=scans)
+    assert obs.scan is scans[-1]
+    assert Observation(0.05, Pose2D(0.0, 0.0), HeadState()).scan is None
+    with pytest.raises(TypeError, match="scans must be a tuple"):
+        Observation(0.05, Pose2D(0.0, 0.0), HeadState(), scans[0])  # type: ignore[arg-type]

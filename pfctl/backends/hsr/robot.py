@@ -4,8 +4,10 @@ One ROS node (rospy) per process. :class:`HsrRobot` subscribes to the topics of 
 :class:`~pfctl.backends.hsr.config.HsrConfig` (the mission's ``backend.hsr``), looks poses up in
 tf, publishes the base and head commands, and drives ``move_base`` through actionlib:
 
-* **observe** — the newest laser scan since the previous observation, posed by tf
-  ``map → <scan frame>`` at the scan's stamp; the newest complete RGB-D frame (RGB, depth,
+* **observe** — every laser scan since the previous observation, in order, each posed by tf
+  ``map → <scan frame>`` at its stamp (the ``laser`` subscriber queues them, at most
+  :data:`SCAN_QUEUE`; when more arrive between two observations the oldest are dropped and
+  counted in :attr:`HsrRobot.dropped_scans`); the newest complete RGB-D frame (RGB, depth,
   camera info and, when configured, the person labels or the person keypoints of one stamp,
   paired within :data:`CAMERA_SLOP`; the keypoints become the frame's ``people``,
   :mod:`pfctl.bags.person_keypoints`), the camera's optical frame from tf
@@ -95,6 +97,8 @@ LOST_ZERO_PERIOD = 0.1
 CLOCK_BACKWARDS = 1.0
 """A ROS clock that jumps back by more than this (s) means the simulator restarted: lost."""
 _QUEUE = 8
+SCAN_QUEUE = 40
+"""Scans kept between two observations (a second of the HSR's 40 Hz Hokuyo); older are dropped."""
 
 
 class RobotConnectionError(UserError):
@@ -243,7 +247,9 @@ class HsrRobot:
         """True when the master's ``/use_sim_time`` was set at start (ROS time from ``/clock``)."""
 
         # receipt state (wall = time.monotonic() when the message arrived)
-        self._scans: deque[tuple[Any, float]] = deque(maxlen=_QUEUE)
+        self._scans: deque[tuple[Any, float]] = deque(maxlen=SCAN_QUEUE)
+        self.dropped_scans = 0
+        """Scans dropped unobserved because :data:`SCAN_QUEUE` were already waiting."""
         self._laser_wall: float | None = None
         self._laser_frame: str | None = None
         self._laser_connected = False
@@ -295,7 +301,9 @@ class HsrRobot:
         sensor, geometry = m["sensor_msgs.msg"], m["geometry_msgs.msg"]
         self._buffer = self._tf2.Buffer(cache_time=rospy.Duration(10.0), debug=False)
         self._listener = self._tf2.TransformListener(self._buffer)
-        self._laser_sub = self._sub(cfg.laser, sensor.LaserScan, self._on_scan, queue_size=_QUEUE)
+        self._laser_sub = self._sub(
+            cfg.laser, sensor.LaserScan, self._on_scan, queue_size=SCAN_QUEUE
+        )
         if cfg.pose is not None:
             self._sub(cfg.pose, geometry.PoseStamped, self._on_pose, queue_size=1)
         self._sub(cfg.joint_states, sensor.JointState, self._on_joints, queue_size=_QUEUE)
@@ -378,6 +386,8 @@ class HsrRobot:
     def _on_scan(self, msg: Any) -> None:
         now = time.monotonic()
         with self._lock:
+            if len(self._scans) == self._scans.maxlen:
+                self.dropped_scans += 1
             self._scans.append((msg, now))
             self._laser_wall = now
             self._laser_frame = _frame(msg.header.frame_id)
@@ -551,6 +561,9 @@ class HsrRobot:
         self._t0_ns = self._last_ns = now_ns
         self._clock_started = False
         self._laser_connected = self._live_publishers() > 0
+        with self._lock:  # the episode starts with the newest scan, not those of the wait
+            while len(self._scans) > 1:
+                self._scans.popleft()
         self._poll_pose(time.monotonic())
         self._last_pose = self._pose() if cfg.pose is None else self._last_pose
         self._stop_viewpoint()
@@ -912,13 +925,13 @@ class HsrRobot:
             raise RuntimeError("the HSR robot is closed")
 
     def observe(self) -> Observation:
-        """The newest scan and frame since the previous observation (or None), the pose, head,
-        odometry and collisions; stamps on the episode clock."""
+        """Every scan since the previous observation (in order), the newest frame since then (or
+        None), the pose, head, odometry and collisions; stamps on the episode clock."""
         self._check_open()
         self._check()
         self._start_clock()
         try:
-            scan = self._take_scan()
+            scans = self._take_scans()
             frame = self._take_frame()
         except BaseException:
             self._stop_base()
@@ -928,7 +941,7 @@ class HsrRobot:
             stamp=self.time,
             pose=self._pose(),
             head=self._head or HeadState(),
-            scan=scan,
+            scans=scans,
             rgbd=frame,
             collisions=truth_collisions if truth_collisions is not None else 0,
             odometry=self._odometry,
@@ -995,8 +1008,26 @@ class HsrRobot:
             pending.extendleft(waiting)
         return out
 
-    def _take_scan(self) -> LaserScan | None:
-        return self._take(self._scans, lambda msg: msg.header, self._posed_scan)
+    def _take_scans(self) -> tuple[LaserScan, ...]:
+        """Every queued scan that tf can pose, oldest first. The first one still waiting for its
+        transform stays, with all newer ones, for the next call (so the order holds); one that
+        cannot be posed at all is dropped."""
+        with self._lock:
+            items = list(self._scans)
+            self._scans.clear()
+        out: list[LaserScan] = []
+        for k, (msg, received) in enumerate(items):
+            tf, wait = self._posed(_frame(msg.header.frame_id), msg.header.stamp, received)
+            if wait:
+                with self._lock:
+                    keep = items[k:] + list(self._scans)
+                    self.dropped_scans += max(0, len(keep) - SCAN_QUEUE)
+                    self._scans.clear()
+                    self._scans.extend(keep[-SCAN_QUEUE:])
+                break
+            if tf is not None:
+                out.append(self._posed_scan(msg, tf))
+        return tuple(out)
 
     def _take_frame(self) -> RgbdFrame | None:
         return self._take(self._frames, lambda msgs: msgs[0].header, self._decode_frame)

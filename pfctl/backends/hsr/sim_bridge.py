@@ -690,8 +690,8 @@ class SimHsrBridge:
         pubs["joints"].publish(msgs.joint_states(obs))
         if "pose" in pubs:
             pubs["pose"].publish(msgs.pose(obs))
-        if obs.scan is not None:
-            pubs["laser"].publish(msgs.scan(obs.scan))
+        for scan in obs.scans:
+            pubs["laser"].publish(msgs.scan(scan))
             self.stats.scans += 1
         if obs.rgbd is not None:
             frame = obs.rgbd
@@ -815,7 +815,7 @@ class SimHsrBridge:
         frame_due = math.floor(t / period + 1e-9) > math.floor((t - robot.substep) / period + 1e-9)
         return replace(
             first,
-            scan=first.scan if k % laser_every == 0 else None,
+            scans=first.scans if k % laser_every == 0 else (),
             rgbd=first.rgbd if frame_due else None,
         )
 

@@ -21,7 +21,9 @@ the laser's period. In each sub-step
    camera (``getCameraImage``); the PyBullet bodies of the people and the robot are placed
    before anything is rendered or ray cast.
 
-:meth:`SimRobot.observe` hands out the newest scan and frame (each once), the head angles, the
+:meth:`SimRobot.observe` hands out every scan taken since the previous observation (oldest first;
+at most a second's worth is kept, older ones are dropped and counted in
+:attr:`SimRobot.dropped_scans`) and the newest frame (each once), the head angles, the
 collision count, the map-frame pose as localisation reports it (the true pose plus an error that
 wanders slowly, std ``pose_noise.localization_*``; each scan's pose is the laser's pose as the
 robot believes it, so the scan lands in the map as it would on the real robot) and the odometry
@@ -36,6 +38,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections import deque
 from dataclasses import dataclass, replace
 from typing import Literal
 
@@ -151,7 +154,10 @@ class SimRobot:
         self._cmd = STOP
         self._navigating = False
         self._in_contact = False
-        self._scan: LaserScan | None = None
+        self._scans: deque[LaserScan] = deque(maxlen=max(self.substeps, math.ceil(rate)))
+        """The scans not observed yet (a second's worth at most, oldest dropped)."""
+        self.dropped_scans = 0
+        """Scans dropped unobserved because more than a second's worth was waiting."""
         self._scan_points: np.ndarray | None = None
         self._frame: RgbdFrame | None = None
         self._next_scan = 0.0
@@ -247,13 +253,15 @@ class SimRobot:
         self._sense()
 
     def observe(self) -> Observation:
-        scan, frame = self._scan, self._frame
-        self._scan = self._frame = None
+        """Every scan since the previous observation, the newest frame, the state now."""
+        scans, frame = tuple(self._scans), self._frame
+        self._scans.clear()
+        self._frame = None
         return Observation(
             stamp=self.time,
             pose=self.localized_pose,
             head=self.head.state,
-            scan=scan,
+            scans=scans,
             rgbd=frame,
             collisions=self.collisions,
             odometry=self.odometry,
@@ -262,9 +270,10 @@ class SimRobot:
     def resense(self) -> None:
         """Take the laser scan and camera frame again now, e.g. after people were moved by hand
         (:meth:`Walker.hold`), so that the next :meth:`observe` does not show the scene as it
-        was before."""
+        was before (the scans not observed yet are dropped: they show it too)."""
         if self._closed:
             raise RuntimeError("the simulator is closed")
+        self._scans.clear()
         self._next_scan = self._next_frame = self.time
         self._sense()
 
@@ -374,7 +383,9 @@ class SimRobot:
             scan = self.laser.scan(self.pose, self._legs(), self.time)
             self._scan_points = scan.points()  # MOVE_BASE's view, with the true pose
             believed = self.laser_spec.laser_pose(self.localized_pose)
-            self._scan = scan if believed == scan.pose else replace(scan, pose=believed)
+            if len(self._scans) == self._scans.maxlen:
+                self.dropped_scans += 1
+            self._scans.append(scan if believed == scan.pose else replace(scan, pose=believed))
             period = 1.0 / self.config.laser.rate_hz
             while self._next_scan <= self.time + eps:
                 self._next_scan += period

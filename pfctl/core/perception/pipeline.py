@@ -1,7 +1,9 @@
 """The robot's sense of people (§II-E): laser legs and camera people → tracks → who is the target.
 
 One :class:`Perception` holds the parts of the paper's perception and runs them per sensor
-message, in the order the follower needs them:
+message, in the order of their stamps (:func:`in_stamp_order`: every scan of an observation at
+its own stamp and laser pose, as leg_tracker and SPENCER track on every scan; the camera's frame
+between the scans taken before and after it):
 
 - a **scan** → :class:`~pfctl.core.perception.legs.detector.LegDetector` (segments, Arras et
   al. features, random forest, leg pairs) → person candidates, and a lone leg (one leg segment:
@@ -172,11 +174,13 @@ class Perception:
         return out
 
     def on_observation(self, observation: Observation) -> None:
-        """Feed what one :class:`~pfctl.core.robot.Observation` brings (scan, frame or both)."""
-        if observation.scan is not None:
-            self.on_scan(observation.scan)
-        if observation.rgbd is not None:
-            self.on_frame(observation.rgbd)
+        """Feed what one :class:`~pfctl.core.robot.Observation` brings (its scans and its frame)
+        in the order of their stamps (:func:`in_stamp_order`)."""
+        for message in in_stamp_order(observation):
+            if isinstance(message, LaserScan):
+                self.on_scan(message)
+            else:
+                self.on_frame(message)
 
     def _forget_deleted(self) -> None:
         alive = {t.id for t in self.tracker.tracks()}
@@ -226,9 +230,21 @@ class Perception:
             self.identifier.close()
 
 
+def in_stamp_order(observation: Observation) -> list[LaserScan | RgbdFrame]:
+    """The observation's scans and frame in the order of their stamps; a scan with the frame's
+    stamp comes first, so that its lone legs meet the previous frame's people, as they did when
+    one scan came per tick."""
+    messages: list[LaserScan | RgbdFrame] = list(observation.scans)
+    frame = observation.rgbd
+    if frame is not None:
+        after = [k for k, scan in enumerate(messages) if scan.stamp > frame.stamp]
+        messages.insert(after[0] if after else len(messages), frame)
+    return messages
+
+
 def track_rows(stamp: float, tracks: Sequence[Track], target_id: int | None) -> list[TrackRow]:
     """One ``(t, track_id, x, y, vx, vy, confidence, is_target)`` row per track."""
     return [(stamp, t.id, t.x, t.y, t.vx, t.vy, t.confidence, t.id == target_id) for t in tracks]
 
 
-__all__ = ["CameraSighting", "Perception", "track_rows"]
+__all__ = ["CameraSighting", "Perception", "in_stamp_order", "track_rows"]

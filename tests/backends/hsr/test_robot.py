@@ -203,6 +203,25 @@ def test_observe_over_ros(ros_master, ros_nodes):
     assert float(duration) == pytest.approx(max(abs(1.75 - 0.3), abs(-1.57 + 0.2)) / 1.0)
 
 
+def test_every_queued_scan_is_observed_in_order_and_overflow_is_counted(ros_master, ros_nodes):
+    """The fake laser runs at 20 Hz and the control period is 0.1 s: each observation hands out
+    every scan since the previous one (about two), in order, none repeated or skipped; scans
+    nobody observes queue up to ``SCAN_QUEUE``, the oldest dropped and counted."""
+    _sim_time(ros_master)
+    _fake(ros_nodes, "--sim-time")
+    driver = _node(ros_nodes, "hsr_driver.py", "scans", "--periods", "10")
+    got = driver.event("scans")
+    assert driver.finish() == 0, driver.lines[-10:]
+    observed = got["observed"]
+    stamps = np.array([s for scans in observed[1:] for s in scans])  # from the second period
+    assert sum(len(scans) >= 2 for scans in observed[1:]) >= 5  # more than one scan per tick
+    np.testing.assert_allclose(np.diff(stamps), 0.05, atol=1e-6)  # in order, none lost
+    late = np.array(got["late"])
+    assert len(late) == got["queue"] == 40 and got["dropped"] >= 5
+    np.testing.assert_allclose(np.diff(late), 0.05, atol=1e-6)  # the newest 40, in order
+    assert late[0] > stamps[-1] + 0.05 * got["dropped"] - 1e-6  # the oldest were dropped
+
+
 def test_depth_16uc1_and_32fc1_give_the_same_people(ros_master, ros_nodes):
     """The same person from millimetres (16UC1) and metres (32FC1, bgr8 colour), on a wall
     clock (a real robot: no /use_sim_time); the second with the pose from /global_pose and a

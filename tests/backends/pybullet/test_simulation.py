@@ -289,3 +289,32 @@ def test_close_stops_the_base_and_is_idempotent(house: Mission) -> None:
     robot.close()
     with pytest.raises(RuntimeError):
         robot.step()
+
+
+def test_every_scan_of_a_tick_is_observed_in_order_at_its_own_pose(two_rooms: Mission) -> None:
+    config = sim_config(_empty(two_rooms))
+    assert (config.laser.rate_hz, 1.0 / config.tick_period) == (40.0, 10.0)
+    with SimRobot(config, SimOptions(camera=False)) as robot:
+        robot.observe()  # the scan taken at start
+        robot.command(Twist2D(0.2, 0.0, 0.0))
+        stamps: list[float] = []
+        for _ in range(5):
+            robot.step()
+            obs = robot.observe()
+            assert len(obs.scans) == 4 and obs.scan is obs.scans[-1]
+            assert obs.scans[-1].stamp == pytest.approx(obs.stamp)
+            xs = [scan.pose.x for scan in obs.scans]
+            assert np.all(np.diff(xs) > 0)  # each at its own pose
+            stamps += [scan.stamp for scan in obs.scans]
+        assert np.allclose(np.diff(stamps), 0.025)  # increasing, none repeated nor skipped
+        assert robot.dropped_scans == 0
+        assert robot.observe().scans == ()  # each scan is handed out once
+
+
+def test_unobserved_scans_are_kept_for_a_second_and_the_rest_counted(two_rooms: Mission) -> None:
+    with SimRobot(sim_config(_empty(two_rooms)), SimOptions(camera=False)) as robot:
+        for _ in range(15):  # 1.5 s: 60 scans after the one taken at start
+            robot.step()
+        scans = robot.observe().scans
+        assert len(scans) == 40 and robot.dropped_scans == 21
+        assert scans[0].stamp == pytest.approx(0.525) and scans[-1].stamp == pytest.approx(1.5)

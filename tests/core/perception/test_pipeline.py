@@ -7,15 +7,33 @@ from any camera detection (a table's leg) stays no one."""
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from pfctl.core.perception.legs.detector import LegDetector, LegParams
-from pfctl.core.perception.pipeline import CAMERA_MAX_AGE, SINGLE_LEG_DISTANCE, Perception
-from pfctl.core.perception.tracking import MultiPersonTracker
+from pfctl.core.perception.legs.detector import (
+    LegDetections,
+    LegDetector,
+    LegParams,
+    PersonCandidate,
+)
+from pfctl.core.perception.pipeline import (
+    CAMERA_MAX_AGE,
+    SINGLE_LEG_DISTANCE,
+    Perception,
+    in_stamp_order,
+)
+from pfctl.core.perception.tracking import MultiPersonTracker, TrackStatus
 from pfctl.core.perception.vision import PersonDetection
-from pfctl.core.robot import CameraInfo, LaserScan, Pose2D, RgbdFrame
+from pfctl.core.robot import (
+    CameraInfo,
+    HeadState,
+    LaserScan,
+    Observation,
+    Pose2D,
+    RgbdFrame,
+)
 
 #: Where she stands side-on, and a table's leg 2 m to her right.
 HER = (3.0, 0.0)
@@ -119,3 +137,66 @@ def test_a_stale_camera_detection_makes_no_candidate() -> None:
     _run(perception, frame_lag=CAMERA_MAX_AGE + 0.02)
     (track,) = perception.tracks(confirmed_only=False)
     assert not perception.has_legs(track.id)
+
+
+class PersonAhead:
+    """A leg detector that finds one person 2 m ahead of each scan's laser pose."""
+
+    def detect(self, scan: LaserScan) -> LegDetections:
+        x, y = scan.pose.x + 2.0, scan.pose.y
+        return LegDetections(scan.stamp, (), (PersonCandidate(x, y, 0.9, ()),))
+
+
+class CountingTracker(MultiPersonTracker):
+    """The tracker, noting each update's sensor and stamp."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.updates: list[tuple[str, float]] = []
+
+    def update(self, sensor: str, detections, fov, t: float):  # type: ignore[no-untyped-def,override]
+        self.updates.append((sensor, t))
+        return super().update(sensor, detections, fov, t)
+
+
+def _tick(t: float, frame: bool) -> Observation:
+    """A 10 Hz tick's observation: the four 40 Hz scans up to ``t``, the laser moving along x
+    at 0.4 m/s; with ``frame``, a camera frame stamped between the second and third scan."""
+    scans = tuple(
+        replace(_scan(s), pose=Pose2D(0.4 * s, 0.0, 0.0))
+        for s in t - np.array([0.075, 0.05, 0.025, 0])
+    )
+    return Observation(
+        t, Pose2D(0.4 * t, 0.0), HeadState(), scans=scans, rgbd=_frame(t - 0.04) if frame else None
+    )
+
+
+def test_each_scan_of_an_observation_updates_the_tracker_at_its_stamp_frame_among_them() -> None:
+    tracker = CountingTracker()
+    perception = Perception(PersonAhead(), tracker, detector=SeesAt(None))  # type: ignore[arg-type]
+    obs = _tick(0.1, frame=True)
+    assert in_stamp_order(obs) == [obs.scans[0], obs.scans[1], obs.rgbd, obs.scans[2], obs.scans[3]]
+    perception.on_observation(obs)
+    assert [sensor for sensor, _ in tracker.updates] == [
+        "laser",
+        "laser",
+        "camera",
+        "laser",
+        "laser",
+    ]
+    stamps = [t for _, t in tracker.updates]
+    np.testing.assert_allclose(stamps, [0.025, 0.05, 0.06, 0.075, 0.1])
+
+
+def test_a_track_is_confirmed_on_scans_alone_within_one_tick() -> None:
+    """``confirm_hits`` scans at 40 Hz confirm a person within one 10 Hz tick (one scan per
+    tick took ``confirm_hits`` ticks), at the position of the newest scan's detection."""
+    tracker = CountingTracker()
+    hits = tracker.params.confirm_hits
+    assert hits <= 4
+    perception = Perception(PersonAhead(), tracker)  # type: ignore[arg-type]
+    perception.on_observation(_tick(0.1, frame=False))
+    assert len(tracker.updates) == 4
+    (track,) = perception.tracks()
+    assert track.status is TrackStatus.CONFIRMED
+    assert track.position == pytest.approx((0.4 * 0.1 + 2.0, 0.0), abs=0.02)

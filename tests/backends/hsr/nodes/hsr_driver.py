@@ -12,6 +12,9 @@ Scenarios:
   ``--interrupt-at-command N``: SIGINT as the N-th base command takes rospy's publish lock.
 * ``navigate``: a goal to move_base, preempted by a direct command; a second one to the end;
   then a second ``HsrRobot`` in the same process.
+* ``scans``: step and observe ``--periods`` control periods, then observe nothing until more
+  scans than the queue holds came in (``dropped_scans`` counts them), then once more; report the
+  scan stamps of each observation and the dropped count.
 * ``connect``: only connect (``--timeout``), report the error if there is one.
 * ``people`` (with ``--keypoints TOPIC``: ``backend.hsr.person_keypoints``): command zero once
   (a bridge holding its episode starts it), then observe ``--frames`` RGB-D frames; report each
@@ -35,7 +38,7 @@ import numpy as np
 import pfctl
 from pfctl.app.hsr import hsr_config
 from pfctl.app.leg_models import load_leg_model
-from pfctl.backends.hsr.robot import HsrRobot
+from pfctl.backends.hsr.robot import SCAN_QUEUE, HsrRobot
 from pfctl.backends.hsr.ros_import import import_ros_module
 from pfctl.core.perception.legs.detector import LegDetector
 from pfctl.core.perception.tracking import FieldOfView
@@ -169,6 +172,19 @@ def navigate(robot: HsrRobot) -> None:
         say("second", node=second.node, same=second.node == robot.node, beams=len(scan.ranges))
 
 
+def scans(robot: HsrRobot, periods: int) -> None:
+    observed = []
+    for _ in range(periods):
+        robot.step()
+        observed.append([scan.stamp for scan in robot.observe().scans])
+    deadline = time.monotonic() + 30.0
+    while robot.dropped_scans < 5 and time.monotonic() < deadline:
+        time.sleep(0.05)  # polling the backend's count: the scans queue meanwhile
+    dropped = robot.dropped_scans
+    late = [scan.stamp for scan in robot.observe().scans]
+    say("scans", observed=observed, late=late, dropped=dropped, queue=SCAN_QUEUE)
+
+
 def people(robot: HsrRobot, frames: int) -> None:
     detector = robot.person_detector()
     robot.command(STOP)  # the first command ends the bridge's hold: the episode starts
@@ -229,11 +245,14 @@ def interrupt_inside_publish(n: int) -> None:
 def main() -> None:
     faulthandler.register(signal.SIGUSR1, all_threads=True)  # a hung driver's stacks
     parser = argparse.ArgumentParser()
-    parser.add_argument("scenario", choices=("observe", "drive", "navigate", "connect", "people"))
+    parser.add_argument(
+        "scenario", choices=("observe", "drive", "navigate", "connect", "people", "scans")
+    )
     parser.add_argument("--timeout", type=float, default=15.0)
     parser.add_argument("--pose", default=None, help="backend.hsr.pose")
     parser.add_argument("--keypoints", default=None, help="backend.hsr.person_keypoints")
     parser.add_argument("--frames", type=int, default=10, help="frames to observe (people)")
+    parser.add_argument("--periods", type=int, default=10, help="periods to observe (scans)")
     parser.add_argument(
         "--interrupt-at-command",
         type=int,
@@ -266,6 +285,7 @@ def main() -> None:
             "navigate": navigate,
             "connect": lambda r: None,
             "people": lambda r: people(r, args.frames),
+            "scans": lambda r: scans(r, args.periods),
         }[args.scenario](robot)
 
 
