@@ -205,6 +205,15 @@ class Perception:
         track_id = self.identifier.target_track()
         return None if track_id is None else self.tracker.track(track_id)
 
+    def candidate(self) -> Track | None:
+        """The ambiguous person worth a look at the face (the identifier's
+        :meth:`~pfctl.core.perception.identity.identifier.TargetIdentifier.candidate_track`), if
+        the tracker still has them."""
+        if self.identifier is None:
+            return None
+        track_id = self.identifier.candidate_track()
+        return None if track_id is None else self.tracker.track(track_id)
+
     def not_target(self, exclude: int | None = None) -> list[tuple[float, float]]:
         """Where the people are whose tracks Algorithm 2 has identified as not the target (track
         ``exclude`` left out)."""

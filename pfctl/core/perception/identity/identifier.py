@@ -661,6 +661,29 @@ class TargetIdentifier:
         only on a face match or a confirmed identification); None: she is lost."""
         return self._named if self._named in self._latest else None
 
+    def candidate_track(self) -> int | None:
+        """An ambiguous person worth going to see the face of (issue 23, item 3): a track with
+        legs decided neither way whose clothes match hers (so only a face can tell), not known
+        to be someone else, its face not yet seen; the most recently seen first. None when she
+        is named, or no one is ambiguous."""
+        if self.target_track() is not None:
+            return None
+        p = self.params
+        best: tuple[float, int] | None = None
+        for tid, ident in self._latest.items():
+            ev = self._tracks[tid]
+            if (
+                ident.decision is Decision.UNKNOWN
+                and ident.legs_seen
+                and not ev.face_distances
+                and ev.distractor is None
+                and ident.clothes_similarity is not None
+                and ident.clothes_similarity >= p.clothes_similarity
+                and (best is None or ident.last_seen > best[0])
+            ):
+                best = (ident.last_seen, tid)
+        return None if best is None else best[1]
+
     def known_tracks(self) -> set[int]:
         """The tracks the identifier holds anything about (to :meth:`forget` when deleted)."""
         return set(self._tracks) | set(self._latest)
