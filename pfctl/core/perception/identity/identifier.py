@@ -6,12 +6,26 @@ face (an embedding distance below ``face_distance``), then by clothes (the histo
 ``S = Σ min(I, T) / Σ T`` of :mod:`pfctl.core.perception.clothes` above ``clothes_similarity``).
 
 Faces are trusted most. A face match confirms a track as the target, a face mismatch rejects it
-even if the clothes match (a look-alike in the same shirt); clothes decide only when no face has
-been seen. The paper applies the filter to each frame; here **the decision and its evidence are
-kept per track over time** (:class:`TrackIdentity`), so one good face match carries the track
+even if the clothes match (a look-alike in the same shirt). The paper applies the filter to each
+frame; here **the evidence is kept per track over time** and weighed as a log-odds belief
+(:mod:`~pfctl.core.perception.identity.log_odds`: face, clothes only as far as they separate her
+from the people about, a distractor mark, continuity), so one good face match carries the track
 through the later frames where the person turns their back, and a mismatching face is remembered
-the same way. When a track has seen faces both ways (a bad detection), the median of its face
-distances decides.
+the same way. When a track has seen faces both ways (a bad detection, or a track the tracker
+swapped onto someone else), the median of its newest ``face_recent`` face distances decides.
+
+**Who is the target** is a name, not a choice made again each frame (issue 23): the named track
+stays the target while the tracker holds it and it is not decided NOT_TARGET — unless another
+track shows her face more recently by ``face_recheck_s`` (the named one was swapped). A new
+track is named at once on a face match, else only after ``confirm_frames`` identifications in a
+row at TARGET over ``confirm_s`` at least (time to go and see the face); while a look-alike is
+about, clothes are no evidence, so only a face names anyone and otherwise she is lost. People
+found not to be her are remembered (:mod:`~pfctl.core.perception.identity.distractors`):
+rejected by face, or seen at the same time as her face-confirmed track away from her
+(:meth:`TargetIdentifier.note_tracks`); a new track where one of them was lost stays rejected.
+Her clothes are learned online, only from frames where a face confirms her and no one else is
+within ``update_clearance``. An ambiguous person (her clothes, no face yet) is offered as
+:meth:`TargetIdentifier.candidate_track` for the robot to go and see the face.
 
 Faces are searched only when it is worth it: until a track has ``face_settled`` face samples, then
 every ``face_recheck_s``; and a track whose last ``face_miss_limit`` searches found no face (the
@@ -144,6 +158,17 @@ class _Evidence:
     """Known not to be her without a face: ``coexisted`` or ``linked`` (distractor memory)."""
     streak: int = 0
     """Identifications in a row at TARGET (the confirmation of a switch without a face)."""
+    last_match: float = -math.inf
+    """Stamp of the frame of the newest face sample that matched hers."""
+    streak_since: float = math.inf
+    """When the current run of identifications at TARGET began."""
+
+    def face(self, recent: int) -> float | None:
+        """The median distance of the newest ``recent`` face samples (None: no face yet): a
+        track the tracker swapped onto someone else shows it within a few faces."""
+        if not self.face_distances:
+            return None
+        return float(np.median(self.face_distances[-recent:]))
 
 
 @dataclass(frozen=True)
@@ -481,6 +506,8 @@ class TargetIdentifier:
         if d is None:
             return
         ev.face_distances.append(d)
+        if d < self.params.face_distance:
+            ev.last_match = max(ev.last_match, stamp)
         ev.last_face = max(ev.last_face, stamp)
         ev.face_misses = 0
         ev.face_box, ev.face_box_at = box, now
@@ -494,7 +521,7 @@ class TargetIdentifier:
 
     def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
         p = self.params
-        face_d = float(np.median(ev.face_distances)) if ev.face_distances else None
+        face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
         clothes = float(np.mean(ev.clothes)) if ev.clothes else None
         now = ev.last_seen
@@ -519,7 +546,11 @@ class TargetIdentifier:
             decision, conf = Decision.NOT_TARGET, 1.0 / (1.0 + math.exp(lo))
         else:
             decision, conf = Decision.UNKNOWN, 0.0
-        ev.streak = ev.streak + 1 if decision is Decision.TARGET else 0
+        if decision is Decision.TARGET:
+            ev.streak_since = min(ev.streak_since, now) if ev.streak else now
+            ev.streak += 1
+        else:
+            ev.streak, ev.streak_since = 0, math.inf
         return TrackIdentity(
             track_id=track_id,
             decision=decision,
@@ -567,11 +598,16 @@ class TargetIdentifier:
         """Who is the target after this observation (item 2): the named track while the tracker
         holds it and it is not decided NOT_TARGET (continuity); else a track a face decides
         TARGET at once; else a track decided TARGET on ``confirm_frames`` identifications in a
-        row (without a face that can only happen while no look-alike is about: her clothes are
-        no evidence then); else no one — she is lost, and the robot searches."""
+        row over ``confirm_s`` (without a face that can only happen while no look-alike is
+        about: her clothes are no evidence then); else no one — she is lost, and the robot
+        searches."""
         named = self._latest.get(self._named) if self._named is not None else None
         if named is not None and named.decision is not Decision.NOT_TARGET:
-            self._learn_online(t)
+            fresher = self._fresher_face(self._named, self._tracks[self._named].last_match)
+            if fresher is None:
+                self._learn_online(t)
+                return
+            self._named = fresher
             return
         best: tuple[tuple[int, float, float], int] | None = None
         for tid, ident in self._latest.items():
@@ -581,12 +617,36 @@ class TargetIdentifier:
                 ident.face_distance is not None and ident.face_distance < self.params.face_distance
             )
             ev = self._tracks[tid]
-            if not face and ev.streak < self.params.confirm_frames:
+            if not face and not self._confirmed(ev, t):
                 continue
             key = (int(face), ident.log_odds, ident.last_seen)
             if best is None or key > best[0]:
                 best = (key, tid)
         self._named = None if best is None else best[1]
+
+    def _confirmed(self, ev: _Evidence, t: float) -> bool:
+        """Whether a track at TARGET without a face has been so long enough to be named:
+        ``confirm_frames`` identifications in a row over at least ``confirm_s``."""
+        p = self.params
+        return ev.streak >= p.confirm_frames and t - ev.streak_since >= p.confirm_s - STAMP_EPS
+
+    def _fresher_face(self, named: int | None, since: float) -> int | None:
+        """A track other than ``named`` that a face decides TARGET with a face match newer than
+        ``since`` by ``face_recheck_s`` or more (the named track's evidence is older: the tracker
+        may have swapped it onto someone else); the newest such match first."""
+        best: tuple[float, int] | None = None
+        for tid, ident in self._latest.items():
+            ev = self._tracks[tid]
+            if (
+                tid != named
+                and ident.decision is Decision.TARGET
+                and ident.face_distance is not None
+                and ident.face_distance < self.params.face_distance
+                and ev.last_match >= since + self.params.face_recheck_s
+                and (best is None or ev.last_match > best[0])
+            ):
+                best = (ev.last_match, tid)
+        return None if best is None else best[1]
 
     def _learn_online(self, t: float) -> None:
         """Fold the named track's clothes of this frame into her online appearance model — only
@@ -596,7 +656,8 @@ class TargetIdentifier:
         ev = self._tracks.get(self._named) if self._named is not None else None
         if ev is None or p.update_rate <= 0 or self._named in self._crowded:
             return
-        if not ev.face_distances or float(np.median(ev.face_distances)) >= p.face_distance:
+        face = ev.face(p.face_recent)
+        if face is None or face >= p.face_distance:
             return
         if abs(ev.last_clothes - t) > STAMP_EPS or ev.upper is None or ev.lower is None:
             return
@@ -632,9 +693,10 @@ class TargetIdentifier:
         }
         her = self._named
         ev = self._tracks.get(her) if her is not None else None
-        if her is None or ev is None or her not in xy or not ev.face_distances:
+        if her is None or ev is None or her not in xy:
             return
-        if float(np.median(ev.face_distances)) >= p.face_distance:
+        face = ev.face(p.face_recent)
+        if face is None or face >= p.face_distance:
             return
         if not any(tid == her and detected for tid, _, _, detected in tracks):
             return
@@ -663,9 +725,10 @@ class TargetIdentifier:
 
     def candidate_track(self) -> int | None:
         """An ambiguous person worth going to see the face of (issue 23, item 3): a track with
-        legs decided neither way whose clothes match hers (so only a face can tell), not known
-        to be someone else, its face not yet seen; the most recently seen first. None when she
-        is named, or no one is ambiguous."""
+        legs, not named, not decided NOT_TARGET, whose clothes match hers (so only a face can
+        tell: a look-alike may be about, or it is not confirmed yet), not known to be someone
+        else, its face not yet seen; the most recently seen first. None when she is named, or
+        no one is ambiguous."""
         if self.target_track() is not None:
             return None
         p = self.params
@@ -673,7 +736,7 @@ class TargetIdentifier:
         for tid, ident in self._latest.items():
             ev = self._tracks[tid]
             if (
-                ident.decision is Decision.UNKNOWN
+                ident.decision is not Decision.NOT_TARGET
                 and ident.legs_seen
                 and not ev.face_distances
                 and ev.distractor is None

@@ -38,6 +38,12 @@ class IdentityParams:
     benchmarks/bench_identity.py measures it)."""
     face_recheck_s: float = 1.0
     """How often a settled track's face is embedded again, seconds."""
+    face_recent: int = param(
+        5,
+        "A track's face evidence is the median distance of its newest this many face samples"
+        " (a track swapped onto someone else shows it within a few faces).",
+        ge=1,
+    )
     face_miss_limit: int = param(
         3,
         "After this many face searches of a track in a row found no face (the back of the head),"
@@ -77,6 +83,12 @@ class IdentityParams:
         "A new track is named the target without a face match only after this many camera"
         " frames in a row at the accepting log-odds (OCL-RPF's confirmation).",
         ge=1,
+    )
+    confirm_s: float = param(
+        2.0,
+        "... and over at least this long (time for the robot to go and see the face).",
+        unit="s",
+        ge=0,
     )
     look_alike_memory_s: float = param(
         120.0,

@@ -344,15 +344,22 @@ def test_a_look_alike_is_never_the_target_on_clothes_while_she_is_tracked_elsewh
 
 def test_without_a_face_a_new_track_is_named_only_after_confirm_frames_in_a_row() -> None:
     """No look-alike about, no faces: her clothes name a track, but only after
-    ``confirm_frames`` identifications in a row (OCL-RPF's confirmation)."""
-    params = IdentityParams(faces=False)
+    ``confirm_frames`` identifications in a row (OCL-RPF's confirmation) over ``confirm_s``;
+    a frame without the track's clothes matching starts the count again."""
+    params = IdentityParams(faces=False, confirm_frames=5, confirm_s=1.0)
     img, det = _shirt((80, 150), (RED,))
     ident = TargetIdentifier(learn_profile([describe(img, det, params)], params), params)
     named = []
-    for k in range(8):
+    for k in range(15):
         assert ident.observe(1, 0.1 * k, True, det, img).decision is Decision.TARGET
         named.append(ident.target_track())
-    assert named == [None] * (params.confirm_frames - 1) + [1] * (9 - params.confirm_frames)
+    assert named == [None] * 10 + [1] * 5  # 0.0 .. 1.0 s
+    fast = TargetIdentifier(ident.profile, replace(params, confirm_s=0.0))
+    named = []
+    for k in range(8):
+        fast.observe(1, 0.1 * k, True, det, img)
+        named.append(fast.target_track())
+    assert named == [None] * 4 + [1] * 4
 
 
 def test_a_person_rejected_by_face_stays_rejected_when_their_track_is_made_again(learned) -> None:
@@ -387,3 +394,23 @@ def test_her_appearance_is_learned_online_only_when_no_one_is_close(learned) -> 
     ident.note_tracks(0.5, [(1, 2.0, 0.0, True), (2, 2.0, 2.5, True)])
     ident.observe(1, 0.5, True, *_at(her, 2.0, 0.0))
     assert ident.online_appearance is not None
+
+
+def test_her_face_on_another_track_takes_the_name_from_a_track_with_older_faces(learned) -> None:
+    """The tracker swapped track 1 (named by her face at 0 s) onto someone seen from behind;
+    track 2 shows her face from 1.5 s on: the name moves to track 2 then (as soon as the face
+    search, backed off while track 2 showed its back, finds it), not before."""
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    ident.observe(1, 0.0, True, *_at(_picture(RED, TARGET_FACE), 2.0, 0.0))
+    assert ident.target_track() == 1
+    for k in range(1, 30):
+        t = 0.1 * k
+        ident.observe(1, t, True, *_at(_picture(RED, None), 2.0, 0.0))
+        if t >= 0.5:
+            face = TARGET_FACE if t >= 1.5 else None
+            ident.observe(2, t, True, *_at(_picture(RED, face), 2.0, 2.0))
+        if t < 1.5 - 1e-9:
+            assert ident.target_track() == 1, t
+        elif t >= 2.0 - 1e-9:
+            assert ident.target_track() == 2, t
