@@ -261,7 +261,8 @@ class TargetIdentifier:
         self._named: int | None = None
         """The track named the target (switched only on confirmation, :meth:`target_track`)."""
         self._look_alike_at = -math.inf
-        """When a person in her clothes was last found not to be her."""
+        """When a person in her clothes was last found not to be her (by face, or seen beside
+        her, or linked to someone who was)."""
         self._crowded: set[int] = set()
         """Tracks with another person within ``update_clearance`` (at the latest
         :meth:`note_tracks`)."""
@@ -530,6 +531,8 @@ class TargetIdentifier:
         elif face_d is not None and track_id in self.distractors.people:
             self.distractors.forget(track_id)  # her face: a wrong link or mark
             ev.distractor = None
+        if ev.distractor is not None and clothes is not None and clothes >= p.clothes_similarity:
+            self._look_alike_at = max(self._look_alike_at, now)  # someone else in her clothes
         cues = Cues(
             face_distance=face_d,
             clothes_similarity=clothes,

@@ -92,8 +92,8 @@ class IdentityParams:
     )
     look_alike_memory_s: float = param(
         120.0,
-        "After a person in her clothes was found not to be her, her clothes are no evidence"
-        " for this long (a look-alike is about).",
+        "After a person in her clothes was found not to be her (by face, or seen beside her),"
+        " her clothes are no evidence for this long (a look-alike is about).",
         unit="s",
         ge=0,
     )
