@@ -663,8 +663,7 @@ class SeeFace(Action):
     the robot's side of them when they stand), at least ``aside`` off a walker's path ahead (not
     in their way; :func:`~pfctl.core.perception.viewpoints.face_viewpoint`), re-planned every
     ``REPLAN_S`` seconds, with the head aimed at their face (``face_height``); the place and the
-    way there keep ``PERSON_RADIUS`` from the other people, and with anyone within ``MIN_GAP``
-    the robot holds still and only looks (it must not collide). SUCCESS when the
+    way there keep ``PERSON_RADIUS`` from the other people. SUCCESS when the
     face has decided (she is the target now, or the person is no longer a candidate); FAILURE
     without a candidate, when no such place can be reached, or after ``timeout`` s — the same
     person is not tried again for ``retry_s``."""
@@ -694,8 +693,6 @@ class SeeFace(Action):
     LEAD_S: ClassVar[float] = 1.0
     #: The other people are discs of this radius (m) the place and the way there keep clear of.
     PERSON_RADIUS: ClassVar[float] = 0.4
-    #: With someone this close (m), the robot holds still and only looks.
-    MIN_GAP: ClassVar[float] = 0.8
 
     def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
         super().__init__(name, namespace, params)
@@ -733,14 +730,6 @@ class SeeFace(Action):
             self._given_up[c.track_id] = self.t
             self.intents.stop()
             return Status.FAILURE
-        pose = self.bb.pose
-        people = np.asarray(self.world.people_xy, dtype=float).reshape(-1, 2)
-        if (
-            len(people)
-            and float(np.min(np.hypot(people[:, 0] - pose.x, people[:, 1] - pose.y))) < self.MIN_GAP
-        ):
-            self.intents.stop()  # someone is close: no driving into them
-            return Status.RUNNING
         facing = math.atan2(c.y - self._goal[1], c.x - self._goal[0])
         if self.intents.go_to(self._goal, self.params["tolerance"], facing) == "failed":
             self._given_up[c.track_id] = self.t
