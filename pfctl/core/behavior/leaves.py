@@ -662,8 +662,7 @@ class SeeFace(Action):
     to a place in front of them ``range_min``..``range_max`` m away (the direction they walk, or
     the robot's side of them when they stand), at least ``aside`` off a walker's path ahead (not
     in their way; :func:`~pfctl.core.perception.viewpoints.face_viewpoint`), re-planned every
-    ``REPLAN_S`` seconds, with the head aimed at their face (``face_height``); the place and the
-    way there keep ``PERSON_RADIUS`` from the other people. SUCCESS when the
+    ``REPLAN_S`` seconds, with the head aimed at their face (``face_height``). SUCCESS when the
     face has decided (she is the target now, or the person is no longer a candidate); FAILURE
     without a candidate, when no such place can be reached, or after ``timeout`` s — the same
     person is not tried again for ``retry_s``."""
@@ -691,8 +690,6 @@ class SeeFace(Action):
     WALKING: ClassVar[float] = 0.2
     #: A walker's place is chosen where they will be this far ahead, s.
     LEAD_S: ClassVar[float] = 1.0
-    #: The other people are discs of this radius (m) the place and the way there keep clear of.
-    PERSON_RADIUS: ClassVar[float] = 0.4
 
     def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
         super().__init__(name, namespace, params)
@@ -746,13 +743,8 @@ class SeeFace(Action):
         else:
             facing = math.atan2(pose.y - c.y, pose.x - c.x)
             at = c.xy
-        people = np.asarray(self.world.people_xy, dtype=float).reshape(-1, 2)
-        others = people[np.hypot(people[:, 0] - c.x, people[:, 1] - c.y) > self.PERSON_RADIUS]
-        planner = self.world.planner
-        if len(others):
-            planner = planner.with_obstacles(others, self.PERSON_RADIUS)
         place = face_viewpoint(
-            planner,
+            self.world.planner,
             (pose.x, pose.y),
             at,
             facing,

@@ -65,7 +65,7 @@ class Rig:
         for key in KEYS:
             self.bb.register_key(key, access=Access.WRITE)
         self.intents = Intents()
-        self.bb.world = SimpleNamespace(planner=_room(), people_xy=np.empty((0, 2)))
+        self.bb.world = SimpleNamespace(planner=_room())
         self.bb.intents, self.bb.target, self.bb.last_seen, self.bb.prediction = (
             self.intents,
             None,
@@ -123,18 +123,3 @@ def test_it_gives_up_after_timeout_and_does_not_try_the_same_person_again_soon()
     other = TargetState(10, 6.0, 1.0, 0.0, 0.0, 20.0)
     assert rig.tick(20.1, other, robot) is Status.RUNNING  # someone else: yes
     assert rig.tick(40.0, him, robot) is Status.SUCCESS  # the candidate changed: decided
-
-
-def test_the_place_keeps_clear_of_the_other_people() -> None:
-    rig = Rig()
-    her = TargetState(7, 6.0, 3.0, 0.0, 0.0, 0.0)
-    robot = Pose2D(1.0, 3.0)
-    assert rig.tick(0.0, her, robot) is Status.RUNNING
-    alone = rig.intents.goals[-1]
-    # someone stands where the robot would have gone: the place keeps clear of him
-    rig = Rig()
-    rig.bb.world.people_xy = np.array([alone, her.xy])
-    assert rig.tick(0.0, her, robot) is Status.RUNNING
-    goal = rig.intents.goals[-1]
-    assert math.dist(goal, alone) > SeeFace.PERSON_RADIUS
-    assert 1.5 - RES <= math.dist(goal, her.xy) <= 2.5 + RES
