@@ -184,6 +184,7 @@ class Follower:
         self._writer.world = self.world
         self._writer.intents = self.intents
         self._writer.waypoint = None
+        self._writer.candidate = None
         self._writer.true_target = None
         self._true_target = true_target
         self._now = 0.0
@@ -260,6 +261,13 @@ class Follower:
 
     def _target_state(self) -> TargetState | None:
         track = self.perception.target()
+        if track is None:
+            return None
+        return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
+
+    def _candidate_state(self) -> TargetState | None:
+        """The ambiguous person worth a look at the face (issue 23, item 3), as a track state."""
+        track = self.perception.candidate()
         if track is None:
             return None
         return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
@@ -380,6 +388,7 @@ class Follower:
         w.target = target
         w.last_seen = self._last_seen
         w.prediction = self._prediction
+        w.candidate = self._candidate_state() if target is None else None
         if self._true_target is not None:
             w.true_target = self._true_target()
         self.intents.begin(obs.stamp, obs.pose)
@@ -447,7 +456,8 @@ class Follower:
         """The head angles ``intent`` asks for from ``pose``."""
         if isinstance(intent, LookAt):
             control = self.params.control
-            point = (intent.xy[0], intent.xy[1], control.look_height)
+            height = control.look_height if intent.height is None else intent.height
+            point = (intent.xy[0], intent.xy[1], height)
             return gaze_angles(pose, point, control)
         return HeadTarget(intent.pan, intent.tilt)
 

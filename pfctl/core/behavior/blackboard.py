@@ -31,6 +31,8 @@ KEYS: dict[str, str] = {
     "world": "WorldModel: the robot's occupancy grid, the static map's planner, the regions and "
     "the people it tracks, for the leaves' control laws and Algorithm 1",
     "intents": "Intents: what the leaves want the base and the head to do this tick",
+    "candidate": "TargetState | None: while she is not named, an ambiguous person (her clothes, "
+    "no face seen yet, not known to be someone else) worth going to see the face of (see_face)",
     "waypoint": "WaypointDecision | None: Algorithm 1's latest way-point (waypoint_search)",
     "true_target": "PRIVILEGED (simulator's ground truth) tuple[float, float] | None: where the "
     "target really is; filled only for a tree naming oracle_search, the one leaf that reads it",

@@ -82,6 +82,8 @@ class LookAt:
 
     xy: tuple[float, float]
     source: str
+    height: float | None = None
+    """Aim at this height on them, m (None: the control's ``look_height``, the torso)."""
 
 
 @dataclass(frozen=True)
@@ -291,9 +293,12 @@ class Intents:
 
     # -- head -----------------------------------------------------------------------------------
 
-    def look_at(self, xy: tuple[float, float], source: str = "target") -> None:
-        """Point the head at a person standing at ``xy``."""
-        self.head.append(LookAt((xy[0], xy[1]), source))
+    def look_at(
+        self, xy: tuple[float, float], source: str = "target", height: float | None = None
+    ) -> None:
+        """Point the head at a person standing at ``xy`` (at ``height`` on them, m; None: the
+        torso)."""
+        self.head.append(LookAt((xy[0], xy[1]), source, height))
 
     def set_pan(self, pan: float, tilt: float = 0.0, source: str = "sweep") -> None:
         """Move the head to ``pan``/``tilt`` (a sweep)."""

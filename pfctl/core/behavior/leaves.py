@@ -31,7 +31,7 @@ from pfctl.core.behavior.spec import LeafSpec, param
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.regions import WaypointDecision
-from pfctl.core.perception.viewpoints import nearest_viewpoint
+from pfctl.core.perception.viewpoints import face_viewpoint, nearest_viewpoint
 from pfctl.core.search.next_look import Look, rank_looks
 
 
@@ -685,6 +685,106 @@ class OracleSearch(Action):
         return Status.RUNNING
 
 
+class SeeFace(Action):
+    """Go and see the face of an ambiguous person (issue 23, item 3): someone in her clothes
+    whose face has not been seen (blackboard key ``candidate``), while she is not named. Drives
+    to a place in front of them ``range_min``..``range_max`` m away (the direction they walk, or
+    the robot's side of them when they stand), at least ``aside`` off a walker's path ahead (not
+    in their way; :func:`~pfctl.core.perception.viewpoints.face_viewpoint`), re-planned every
+    ``REPLAN_S`` seconds, with the head aimed at their face (``face_height``). SUCCESS when the
+    face has decided (she is the target now, or the person is no longer a candidate); FAILURE
+    without a candidate, when no such place can be reached, or after ``timeout`` s — the same
+    person is not tried again for ``retry_s``."""
+
+    spec = LeafSpec(
+        "see_face",
+        "action",
+        "Drive to a place in front of an ambiguous person (her clothes, no face seen yet), "
+        "head at face height, until their face decides; gives up after timeout s.",
+        (
+            param("range_min", 1.5, "nearest distance to them, m", minimum=0.5),
+            param("range_max", 2.5, "farthest distance to them, m", minimum=1.0),
+            param("timeout", 15.0, "give up after this long, s", minimum=1.0),
+            param("retry_s", 30.0, "a person given up on is not tried again for this long, s"),
+            param("face_height", 1.55, "height of the face to aim the head at, m", minimum=0.5),
+            param("aside", 20.0, "degrees off a walker's path ahead the place keeps", minimum=0.0),
+            param("clearance", 0.25, "the line of sight keeps this far from walls, m"),
+            param("tolerance", 0.3, "arrival distance at the place, m", minimum=0.05),
+        ),
+    )
+    reads = (*Leaf.reads, "candidate")
+
+    REPLAN_S: ClassVar[float] = 1.0
+    #: Slower than this (m/s) a person is standing: they are seen from the robot's side.
+    WALKING: ClassVar[float] = 0.2
+    #: A walker's place is chosen where they will be this far ahead, s.
+    LEAD_S: ClassVar[float] = 1.0
+
+    def __init__(self, name: str, namespace: str, params: dict[str, Any]) -> None:
+        super().__init__(name, namespace, params)
+        self._given_up: dict[int, float] = {}
+
+    def initialise(self) -> None:
+        self._track: int | None = None
+        self._started = self.t
+        self._goal: tuple[float, float] | None = None
+        self._decided_at = -math.inf
+
+    @property
+    def candidate(self) -> TargetState | None:
+        value: TargetState | None = self.bb.candidate
+        return value
+
+    def act(self) -> Status:
+        if self.visible():
+            return Status.SUCCESS
+        c = self.candidate
+        if c is None or (self._track is not None and c.track_id != self._track):
+            return Status.FAILURE if self._track is None else Status.SUCCESS
+        if self.t - self._given_up.get(c.track_id, -math.inf) < self.params["retry_s"]:
+            return Status.FAILURE
+        if self._track is None:
+            self._track, self._started = c.track_id, self.t
+        if self.t - self._started >= self.params["timeout"]:
+            self._given_up[c.track_id] = self.t
+            return Status.FAILURE
+        self.intents.look_at(c.xy, "see_face", self.params["face_height"])
+        if self._goal is None or self.t - self._decided_at >= self.REPLAN_S:
+            self._goal = self._place(c)
+            self._decided_at = self.t
+        if self._goal is None:
+            self._given_up[c.track_id] = self.t
+            self.intents.stop()
+            return Status.FAILURE
+        facing = math.atan2(c.y - self._goal[1], c.x - self._goal[0])
+        if self.intents.go_to(self._goal, self.params["tolerance"], facing) == "failed":
+            self._given_up[c.track_id] = self.t
+            return Status.FAILURE
+        return Status.RUNNING
+
+    def _place(self, c: TargetState) -> tuple[float, float] | None:
+        pose = self.bb.pose
+        speed = math.hypot(c.vx, c.vy)
+        walking = speed >= self.WALKING
+        if walking:
+            facing = math.atan2(c.vy, c.vx)
+            at = (c.x + c.vx * self.LEAD_S, c.y + c.vy * self.LEAD_S)
+        else:
+            facing = math.atan2(pose.y - c.y, pose.x - c.x)
+            at = c.xy
+        place = face_viewpoint(
+            self.world.planner,
+            (pose.x, pose.y),
+            at,
+            facing,
+            float(self.params["range_min"]),
+            float(self.params["range_max"]),
+            aside=math.radians(self.params["aside"]) if walking else 0.0,
+            clearance=float(self.params["clearance"]),
+        )
+        return None if place is None else place.xy
+
+
 class Stop(Action):
     """Stop the base; SUCCESS."""
 
@@ -712,6 +812,7 @@ LEAF_CLASSES: dict[str, type[Leaf]] = {
         WaypointSearch,
         GoToLastSeen,
         OracleSearch,
+        SeeFace,
         Stop,
     )
 }
@@ -719,7 +820,7 @@ LEAF_CLASSES: dict[str, type[Leaf]] = {
 #: Search actions: when one of them runs while the target is lost, the robot is "predicted"
 #: (going to the prediction and looking there) or "searching" (Algorithm 1).
 PREDICTION_ACTIONS = ("go_to_prediction", "look_around")
-SEARCH_ACTIONS = ("waypoint_search", "go_to_last_seen", "oracle_search")
+SEARCH_ACTIONS = ("waypoint_search", "go_to_last_seen", "oracle_search", "see_face")
 
 #: Leaves that read the simulator's ground truth (the oracle baseline): a tree naming one runs
 #: only in the simulator, which gives it the truth; the real robot refuses it.

@@ -19,11 +19,13 @@ between the scans taken before and after it):
   the same tracker (``camera`` detections, the camera's floor wedge) → Algorithm 2
   (:class:`~pfctl.core.perception.identity.identifier.TargetIdentifier`, one call per frame) for
   every track the camera saw, with "has legs" meaning the laser has associated leg detections
-  with that track (with a face worker, its results are folded in there too); and, when a
+  with that track (with a face worker, its results are folded in there too), after telling it
+  where every track is (who is seen beside her, who stands close to whom); and, when a
   :class:`~pfctl.core.perception.belief.HumanBelief` is given, the Eq. 4 update of the camera's
   view.
 
-The target is the track Algorithm 2 names, as long as the tracker still has it.
+The target is the track the identifier names (kept while the tracker has it, switched only on
+confirmation), as long as the tracker still has it.
 """
 
 from __future__ import annotations
@@ -118,6 +120,13 @@ class Perception:
         self._forget_deleted()
         identities: dict[int, TrackIdentity] = {}
         if self.identifier is not None:
+            self.identifier.note_tracks(
+                frame.stamp,
+                [
+                    (t.id, t.x, t.y, t.status is TrackStatus.CONFIRMED)
+                    for t in self.tracker.tracks()
+                ],
+            )
             seen = [
                 (track_id, track_id in self._leg_tracks, person)
                 for person, track_id in zip(people, ids, strict=True)
@@ -186,7 +195,7 @@ class Perception:
         alive = {t.id for t in self.tracker.tracks()}
         self._leg_tracks &= alive
         if self.identifier is not None:
-            for gone in set(self.identifier.identities()) - alive:
+            for gone in self.identifier.known_tracks() - alive:
                 self.identifier.forget(gone)
 
     def tracks(self, *, confirmed_only: bool = True) -> list[Track]:
@@ -198,6 +207,15 @@ class Perception:
         if self.identifier is None:
             return None
         track_id = self.identifier.target_track()
+        return None if track_id is None else self.tracker.track(track_id)
+
+    def candidate(self) -> Track | None:
+        """The ambiguous person worth a look at the face (the identifier's
+        :meth:`~pfctl.core.perception.identity.identifier.TargetIdentifier.candidate_track`), if
+        the tracker still has them."""
+        if self.identifier is None:
+            return None
+        track_id = self.identifier.candidate_track()
         return None if track_id is None else self.tracker.track(track_id)
 
     def not_target(self, exclude: int | None = None) -> list[tuple[float, float]]:

@@ -99,4 +99,42 @@ def nearest_viewpoint(
     )
 
 
-__all__ = ["Viewpoint", "nearest_viewpoint", "viewpoint_mask"]
+def face_viewpoint(
+    planner: GridPlanner,
+    robot_xy: ArrayLike,
+    person_xy: ArrayLike,
+    facing: float,
+    range_min: float,
+    range_max: float,
+    *,
+    half_angle: float = math.radians(60.0),
+    aside: float = 0.0,
+    clearance: float = 0.0,
+) -> Viewpoint | None:
+    """Where to see the face of a person at ``person_xy`` who faces ``facing`` (rad, map
+    frame; issue 23, item 3): of the :func:`viewpoint_mask` cells ``range_min``..``range_max``
+    from them, those within ``half_angle`` of the direction they face and at least ``aside``
+    off it (a walker's own path ahead is left free: not in their way) — the one the robot
+    reaches at the least path cost; None when there is none."""
+    mask = viewpoint_mask(planner, person_xy, range_max, range_min, clearance)
+    px, py = (float(v) for v in np.asarray(person_xy, dtype=float).reshape(2))
+    rows, cols = np.indices(planner.geometry.shape)
+    centres = planner.geometry.cell_to_world(rows, cols)
+    bearing = np.arctan2(centres[..., 1] - py, centres[..., 0] - px)
+    off = np.abs((bearing - facing + math.pi) % (2 * math.pi) - math.pi)
+    mask &= (off <= half_angle) & (off >= aside)
+    if not mask.any():
+        return None
+    try:
+        cost = planner.distances_from(robot_xy)
+    except NoPathError:
+        return None
+    r, c = np.nonzero(mask & np.isfinite(cost))
+    if len(r) == 0:
+        return None
+    best = int(np.lexsort((off[r, c], cost[r, c]))[0])
+    xy = centres[r[best], c[best]]
+    return Viewpoint((float(xy[0]), float(xy[1])), float(cost[r[best], c[best]]))
+
+
+__all__ = ["Viewpoint", "face_viewpoint", "nearest_viewpoint", "viewpoint_mask"]

@@ -230,3 +230,51 @@ def test_describe_on_a_rendered_person_splits_shirt_from_trousers() -> None:
     assert alice.upper is not None and alice.lower is not None and bob.upper is not None
     assert histogram_intersection(alice.upper, alice.lower) < 0.1  # red shirt, navy trousers
     assert histogram_intersection(alice.upper, bob.upper) < 0.1  # red vs blue shirts
+
+
+@pytest.mark.slow
+def test_a_look_alike_from_behind_is_never_named_and_stays_rejected_when_tracked_again() -> None:
+    """Issue 23 on rendered frames: carol wears alice's clothes and shows the robot her back
+    while alice faces it, 1.3 m apart: carol is never the target on her clothes; when both tracks
+    are lost and carol is tracked again where she stood (a new track), she stays rejected — no
+    one is named until alice's face is seen again."""
+    mission = _scene()
+    params = identity_params(mission)
+    encoder = FaceEncoder(params.face)
+    with SimRobot(sim_config(mission, 5)) as robot:
+        detector = _detector(robot)
+        x = ROBOT[0] + 2.0
+        tilt = math.atan2(1.45 - 1.05, 2.0)
+        _line_up(robot, {"alice": (x, 2.4, 0.0), "carol": (x, 3.7, math.pi), "bob": (8, 0.5, 0)})
+        frame = _frame(robot, tilt)
+        her = next(d for d in detector.detect(frame) if d.ground_truth_name == "alice")
+        profile = learn_profile([describe(frame.rgb, her, params, encoder)], params)
+        assert len(profile.faces) == 1
+        identifier = TargetIdentifier(profile, params)
+        names: dict[int, str] = {}
+
+        def look(ids: dict[str, int]) -> None:
+            frame = _frame(robot, tilt)
+            seen = [d for d in detector.detect(frame) if d.ground_truth_name in ids]
+            tracks = [(ids[str(d.ground_truth_name)], *d.position[:2], True) for d in seen]
+            identifier.note_tracks(frame.stamp, tracks)  # type: ignore[arg-type]
+            for d in seen:
+                tid = ids[str(d.ground_truth_name)]
+                names[tid] = str(d.ground_truth_name)
+                ident = identifier.observe(tid, frame.stamp, True, d, frame.rgb)
+                if d.ground_truth_name == "carol":
+                    assert ident.decision is not Decision.TARGET
+                    assert ident.clothes_similarity is not None and ident.clothes_similarity > 0.6
+
+        for _ in range(6):
+            look({"alice": 1, "carol": 2})
+            assert identifier.target_track() == 1
+        identifier.forget(1)
+        identifier.forget(2)  # both lost; alice walks off, carol is tracked again (track 3)
+        _line_up(robot, {"alice": (8, 5.5, 0.0), "carol": (x, 3.7, math.pi), "bob": (8, 0.5, 0)})
+        for _ in range(25):  # 3 s: more than confirm_s
+            look({"carol": 3})
+            assert identifier.target_track() is None
+            assert identifier.candidate_track() is None  # known not to be her: no need to look
+        assert identifier.identity(3) is not None
+        assert identifier.identity(3).basis == "distractor"  # type: ignore[union-attr]

@@ -6,12 +6,26 @@ face (an embedding distance below ``face_distance``), then by clothes (the histo
 ``S = Σ min(I, T) / Σ T`` of :mod:`pfctl.core.perception.clothes` above ``clothes_similarity``).
 
 Faces are trusted most. A face match confirms a track as the target, a face mismatch rejects it
-even if the clothes match (a look-alike in the same shirt); clothes decide only when no face has
-been seen. The paper applies the filter to each frame; here **the decision and its evidence are
-kept per track over time** (:class:`TrackIdentity`), so one good face match carries the track
+even if the clothes match (a look-alike in the same shirt). The paper applies the filter to each
+frame; here **the evidence is kept per track over time** and weighed as a log-odds belief
+(:mod:`~pfctl.core.perception.identity.log_odds`: face, clothes only as far as they separate her
+from the people about, a distractor mark, continuity), so one good face match carries the track
 through the later frames where the person turns their back, and a mismatching face is remembered
-the same way. When a track has seen faces both ways (a bad detection), the median of its face
-distances decides.
+the same way. When a track has seen faces both ways (a bad detection, or a track the tracker
+swapped onto someone else), the median of its newest ``face_recent`` face distances decides.
+
+**Who is the target** is a name, not a choice made again each frame (issue 23): the named track
+stays the target while the tracker holds it and it is not decided NOT_TARGET — unless another
+track shows her face more recently by ``face_recheck_s`` (the named one was swapped). A new
+track is named at once on a face match, else only after ``confirm_frames`` identifications in a
+row at TARGET over ``confirm_s`` at least (time to go and see the face); while a look-alike is
+about, clothes are no evidence, so only a face names anyone and otherwise she is lost. People
+found not to be her are remembered (:mod:`~pfctl.core.perception.identity.distractors`):
+rejected by face, or seen at the same time as her face-confirmed track away from her
+(:meth:`TargetIdentifier.note_tracks`); a new track where one of them was lost stays rejected.
+Her clothes are learned online, only from frames where a face confirms her and no one else is
+within ``update_clearance``. An ambiguous person (her clothes, no face yet) is offered as
+:meth:`TargetIdentifier.candidate_track` for the robot to go and see the face.
 
 Faces are searched only when it is worth it: until a track has ``face_settled`` face samples, then
 every ``face_recheck_s``; and a track whose last ``face_miss_limit`` searches found no face (the
@@ -58,8 +72,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pfctl.core.perception.clothes import convert
+from pfctl.core.perception.clothes import convert, histogram_intersection
 from pfctl.core.perception.faces import Box, Face, FaceEncoder
+from pfctl.core.perception.identity.distractors import DistractorMemory
+from pfctl.core.perception.identity.log_odds import Cues, log_odds
 from pfctl.core.perception.identity.params import IdentityParams
 from pfctl.core.perception.identity.profile import Appearance, TargetProfile, describe, face_region
 from pfctl.core.perception.vision import PersonDetection
@@ -91,9 +107,11 @@ class TrackIdentity:
     track_id: int
     decision: Decision
     confidence: float
-    """Heuristic 0..1: faces ≥ 0.8, clothes ≤ 0.8, unknown 0."""
+    """The probability of the decision from the log-odds (``1 / (1 + e^-|L|)``); 0 for
+    UNKNOWN."""
     basis: str
-    """What decided: ``face``, ``clothes``, ``no_legs`` or ``nothing``."""
+    """The cue that weighs most: ``face``, ``distractor``, ``clothes``, ``continuity``,
+    ``no_legs`` or ``nothing``."""
     face_distance: float | None
     """Median face distance to the profile over the track's face samples (None: no face yet)."""
     best_face_distance: float | None
@@ -107,6 +125,8 @@ class TrackIdentity:
     face_box: Box | None = None
     """Where the face was found, when a face was folded in at this identity's time (inline: in
     this observation's frame; with a worker: in the frame the search was submitted from)."""
+    log_odds: float = 0.0
+    """The belief that the track is the target (:mod:`~pfctl.core.perception.identity.log_odds`)."""
 
 
 @dataclass
@@ -129,6 +149,26 @@ class _Evidence:
     """When ``face_box`` was folded in: identities made then report it."""
     job: tuple[int, int] | None = None
     """The face search of this track out at the worker, if any."""
+    xy: tuple[float, float] | None = None
+    """Where the camera last saw the track (map frame)."""
+    upper: np.ndarray | None = None
+    lower: np.ndarray | None = None
+    """The newest clothing histograms measured."""
+    distractor: str | None = None
+    """Known not to be her without a face: ``coexisted`` or ``linked`` (distractor memory)."""
+    streak: int = 0
+    """Identifications in a row at TARGET (the confirmation of a switch without a face)."""
+    last_match: float = -math.inf
+    """Stamp of the frame of the newest face sample that matched hers."""
+    streak_since: float = math.inf
+    """When the current run of identifications at TARGET began."""
+
+    def face(self, recent: int) -> float | None:
+        """The median distance of the newest ``recent`` face samples (None: no face yet): a
+        track the tracker swapped onto someone else shows it within a few faces."""
+        if not self.face_distances:
+            return None
+        return float(np.median(self.face_distances[-recent:]))
 
 
 @dataclass(frozen=True)
@@ -216,6 +256,18 @@ class TargetIdentifier:
         self._key = next(_IDENTIFIERS)
         """Job keys are ``(key, n)``: several identifiers may share one worker."""
         self._given_worker = worker
+        self.distractors = DistractorMemory(link_radius=self.params.coexist_distance)
+        """The people found not to be her (issue 23, item 4)."""
+        self._named: int | None = None
+        """The track named the target (switched only on confirmation, :meth:`target_track`)."""
+        self._look_alike_at = -math.inf
+        """When a person in her clothes was last found not to be her (by face, or seen beside
+        her, or linked to someone who was)."""
+        self._crowded: set[int] = set()
+        """Tracks with another person within ``update_clearance`` (at the latest
+        :meth:`note_tracks`)."""
+        self._online: tuple[np.ndarray, np.ndarray] | None = None
+        """Her clothing histograms as learned online (item 5), None until learned."""
 
     @property
     def searches_faces(self) -> bool:
@@ -241,11 +293,13 @@ class TargetIdentifier:
         is then searched only when due)."""
         if appearance is not None and detection is not None:
             self.update(t)
-            ev = self._observed(track_id, t, has_legs)
-            self._add_clothes(ev, appearance)
+            ev = self._observed(track_id, t, has_legs, detection)
+            self._add_clothes(ev, appearance, t)
             if appearance.face is not None and self.searches_faces:
                 self._fold_face(ev, t, appearance.face, appearance.face_box, t)
-            return self._identify(track_id, ev, t)
+            identity = self._identify(track_id, ev, t)
+            self._name(t)
+            return identity
         return self.observe_frame(t, rgb, [(track_id, has_legs, detection)])[0]
 
     def observe_frame(
@@ -260,8 +314,8 @@ class TargetIdentifier:
         first (they matter when a worker has few slots)."""
         self.update(t)
         seen: list[tuple[int, _Evidence, PersonDetection | None]] = []
-        for track_id, has_legs, _ in sightings:
-            seen.append((track_id, self._observed(track_id, t, has_legs), None))
+        for track_id, has_legs, detection in sightings:
+            seen.append((track_id, self._observed(track_id, t, has_legs, detection), None))
         if rgb is not None:
             converted = None
             for k, (track_id, ev, _) in enumerate(seen):
@@ -274,7 +328,7 @@ class TargetIdentifier:
                     continue
                 if converted is None:
                     converted = convert(rgb, self.params.clothes.color_space)
-                self._add_clothes(ev, describe(rgb, detection, self.params, None, converted))
+                self._add_clothes(ev, describe(rgb, detection, self.params, None, converted), t)
                 ev.last_clothes = t
                 self.face_stats.clothes_measured += 1
             wanted = [
@@ -288,7 +342,9 @@ class TargetIdentifier:
                 region = face_region(detection, rgb.shape)
                 if region is not None:
                     self._search(track_id, ev, t, rgb, region)
-        return [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
+        identities = [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
+        self._name(t)
+        return identities
 
     def update(self, t: float) -> None:
         """Fold in the worker's results that count at ``t`` (``face_timing``); nothing without
@@ -323,17 +379,53 @@ class TargetIdentifier:
 
     # -- internals ----------------------------------------------------------------------------
 
-    def _observed(self, track_id: int, t: float, has_legs: bool) -> _Evidence:
+    def _observed(
+        self, track_id: int, t: float, has_legs: bool, detection: PersonDetection | None
+    ) -> _Evidence:
         ev = self._tracks.setdefault(track_id, _Evidence())
         ev.observations += 1
         ev.last_seen = t
         ev.legs_seen += bool(has_legs)
+        if detection is not None:
+            ev.xy = (float(detection.position[0]), float(detection.position[1]))
+            self.distractors.seen(track_id, ev.xy, t)
         return ev
 
-    def _add_clothes(self, ev: _Evidence, appearance: Appearance) -> None:
+    def _add_clothes(self, ev: _Evidence, appearance: Appearance, t: float) -> None:
         s = self.profile.similarity(appearance)
-        if s is not None:
-            ev.clothes.append(s)
+        if s is None:
+            return
+        if self._online is not None:
+            online = self._similarity_online(appearance)
+            s = s if online is None else max(s, online)
+        first = not ev.clothes
+        ev.clothes.append(s)
+        ev.upper = appearance.upper if appearance.upper is not None else ev.upper
+        ev.lower = appearance.lower if appearance.lower is not None else ev.lower
+        if first and ev.xy is not None and ev.distractor is None:
+            self._link(ev, t)
+
+    def _similarity_online(self, appearance: Appearance) -> float | None:
+        """Clothes similarity to her online appearance model (as the profile's)."""
+        assert self._online is not None
+        s = [
+            histogram_intersection(h, m)
+            for h, m in ((appearance.upper, self._online[0]), (appearance.lower, self._online[1]))
+            if h is not None
+        ]
+        return min(s) if s else None
+
+    def _link(self, ev: _Evidence, t: float) -> None:
+        """A new track first measured: is it a remembered distractor (item 4)?"""
+        assert ev.xy is not None
+        target = (self.profile.upper, self.profile.lower)
+        known = self.distractors.link(ev.xy, t, ev.upper, ev.lower, target)
+        if known is None:
+            return
+        track_id = next(k for k, v in self._tracks.items() if v is ev)
+        self.distractors.forget(known.track_id)
+        self.distractors.remember(track_id, ev.xy, t, known.why, known.upper, known.lower)
+        ev.distractor = "linked"
 
     def _clothes_due(self, ev: _Evidence, t: float) -> bool:
         """Whether the track's clothes (Algorithm 2's histogram intersection) should be
@@ -415,6 +507,8 @@ class TargetIdentifier:
         if d is None:
             return
         ev.face_distances.append(d)
+        if d < self.params.face_distance:
+            ev.last_match = max(ev.last_match, stamp)
         ev.last_face = max(ev.last_face, stamp)
         ev.face_misses = 0
         ev.face_box, ev.face_box_at = box, now
@@ -428,22 +522,38 @@ class TargetIdentifier:
 
     def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
         p = self.params
-        face_d = float(np.median(ev.face_distances)) if ev.face_distances else None
+        face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
         clothes = float(np.mean(ev.clothes)) if ev.clothes else None
+        now = ev.last_seen
+        if face_d is not None and face_d >= p.face_distance:
+            self._rejected_by_face(track_id, ev, clothes, now)
+        elif face_d is not None and track_id in self.distractors.people:
+            self.distractors.forget(track_id)  # her face: a wrong link or mark
+            ev.distractor = None
+        if ev.distractor is not None and clothes is not None and clothes >= p.clothes_similarity:
+            self._look_alike_at = max(self._look_alike_at, now)  # someone else in her clothes
+        cues = Cues(
+            face_distance=face_d,
+            clothes_similarity=clothes,
+            look_alike_about=self._look_alike_about(track_id, now),
+            distractor=ev.distractor is not None,
+            named=track_id == self._named,
+        )
+        lo, basis = log_odds(cues, p.weights, p.face_distance, p.clothes_similarity)
         if ev.legs_seen == 0:
             decision, conf, basis = Decision.UNKNOWN, 0.0, "no_legs"
-        elif face_d is not None:
-            margin = min(1.0, abs(face_d - p.face_distance) / 0.2)
-            decision = Decision.TARGET if face_d < p.face_distance else Decision.NOT_TARGET
-            conf, basis = 0.8 + 0.2 * margin, "face"
-        elif clothes is not None:
-            margin = min(1.0, abs(clothes - p.clothes_similarity) / 0.3)
-            ok = clothes >= p.clothes_similarity
-            decision = Decision.TARGET if ok else Decision.NOT_TARGET
-            conf, basis = 0.5 + 0.3 * margin, "clothes"
+        elif lo >= p.weights.accept:
+            decision, conf = Decision.TARGET, 1.0 / (1.0 + math.exp(-lo))
+        elif lo <= -p.weights.reject:
+            decision, conf = Decision.NOT_TARGET, 1.0 / (1.0 + math.exp(lo))
         else:
-            decision, conf, basis = Decision.UNKNOWN, 0.0, "nothing"
+            decision, conf = Decision.UNKNOWN, 0.0
+        if decision is Decision.TARGET:
+            ev.streak_since = min(ev.streak_since, now) if ev.streak else now
+            ev.streak += 1
+        else:
+            ev.streak, ev.streak_since = 0, math.inf
         return TrackIdentity(
             track_id=track_id,
             decision=decision,
@@ -458,7 +568,150 @@ class TargetIdentifier:
             legs_seen=ev.legs_seen,
             last_seen=ev.last_seen,
             face_box=face_box,
+            log_odds=lo,
         )
+
+    def _rejected_by_face(
+        self, track_id: int, ev: _Evidence, clothes: float | None, now: float
+    ) -> None:
+        """A face not hers: remember the person (item 4); in her clothes, a look-alike is about."""
+        if ev.xy is not None:
+            self.distractors.remember(track_id, ev.xy, now, "face", ev.upper, ev.lower)
+        if clothes is not None and clothes >= self.params.clothes_similarity:
+            self._look_alike_at = max(self._look_alike_at, now)
+
+    def _look_alike_about(self, track_id: int, now: float) -> bool:
+        """Whether someone in her clothes other than ``track_id`` is about: another track now
+        whose clothes match hers, or a person in her clothes found not to be her within
+        ``look_alike_memory_s``."""
+        p = self.params
+        if now - self._look_alike_at <= p.look_alike_memory_s:
+            return True
+        for tid, other in self._tracks.items():
+            if (
+                tid != track_id
+                and other.clothes
+                and other.legs_seen
+                and float(np.mean(other.clothes)) >= p.clothes_similarity
+            ):
+                return True
+        return False
+
+    def _name(self, t: float) -> None:
+        """Who is the target after this observation (item 2): the named track while the tracker
+        holds it and it is not decided NOT_TARGET (continuity); else a track a face decides
+        TARGET at once; else a track decided TARGET on ``confirm_frames`` identifications in a
+        row over ``confirm_s`` (without a face that can only happen while no look-alike is
+        about: her clothes are no evidence then); else no one — she is lost, and the robot
+        searches."""
+        named = self._latest.get(self._named) if self._named is not None else None
+        if named is not None and named.decision is not Decision.NOT_TARGET:
+            fresher = self._fresher_face(self._named, self._tracks[self._named].last_match)
+            if fresher is None:
+                self._learn_online(t)
+                return
+            self._named = fresher
+            return
+        best: tuple[tuple[int, float, float], int] | None = None
+        for tid, ident in self._latest.items():
+            if ident.decision is not Decision.TARGET:
+                continue
+            face = (
+                ident.face_distance is not None and ident.face_distance < self.params.face_distance
+            )
+            ev = self._tracks[tid]
+            if not face and not self._confirmed(ev, t):
+                continue
+            key = (int(face), ident.log_odds, ident.last_seen)
+            if best is None or key > best[0]:
+                best = (key, tid)
+        self._named = None if best is None else best[1]
+
+    def _confirmed(self, ev: _Evidence, t: float) -> bool:
+        """Whether a track at TARGET without a face has been so long enough to be named:
+        ``confirm_frames`` identifications in a row over at least ``confirm_s``."""
+        p = self.params
+        return ev.streak >= p.confirm_frames and t - ev.streak_since >= p.confirm_s - STAMP_EPS
+
+    def _fresher_face(self, named: int | None, since: float) -> int | None:
+        """A track other than ``named`` that a face decides TARGET with a face match newer than
+        ``since`` by ``face_recheck_s`` or more (the named track's evidence is older: the tracker
+        may have swapped it onto someone else); the newest such match first."""
+        best: tuple[float, int] | None = None
+        for tid, ident in self._latest.items():
+            ev = self._tracks[tid]
+            if (
+                tid != named
+                and ident.decision is Decision.TARGET
+                and ident.face_distance is not None
+                and ident.face_distance < self.params.face_distance
+                and ev.last_match >= since + self.params.face_recheck_s
+                and (best is None or ev.last_match > best[0])
+            ):
+                best = (ev.last_match, tid)
+        return None if best is None else best[1]
+
+    def _learn_online(self, t: float) -> None:
+        """Fold the named track's clothes of this frame into her online appearance model — only
+        when a face confirms the track and no other person is within ``update_clearance``
+        (item 5: the model must not learn a look-alike standing beside her)."""
+        p = self.params
+        ev = self._tracks.get(self._named) if self._named is not None else None
+        if ev is None or p.update_rate <= 0 or self._named in self._crowded:
+            return
+        face = ev.face(p.face_recent)
+        if face is None or face >= p.face_distance:
+            return
+        if abs(ev.last_clothes - t) > STAMP_EPS or ev.upper is None or ev.lower is None:
+            return
+        if self._online is None:
+            self._online = (self.profile.upper.copy(), self.profile.lower.copy())
+        r = p.update_rate
+        upper = (1 - r) * self._online[0] + r * ev.upper
+        lower = (1 - r) * self._online[1] + r * ev.lower
+        self._online = (upper / upper.sum(), lower / lower.sum())
+
+    @property
+    def online_appearance(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """Her upper and lower clothing histograms as learned online (None: not learned yet)."""
+        return self._online
+
+    def note_tracks(self, t: float, tracks: Sequence[tuple[int, float, float, bool]]) -> None:
+        """The tracker's people now, ``(track_id, x, y, detected)`` (detected: not coasting).
+
+        While the named target is confirmed by her face and detected, every other detected
+        track at least ``coexist_distance`` from her is someone else (two places at once) and
+        is marked so — a face match of its own is the only way back (item 1). Which tracks have
+        another person within ``update_clearance`` is kept for the online appearance model
+        (item 5)."""
+        p = self.params
+        xy = {tid: (x, y) for tid, x, y, _ in tracks}
+        self._crowded = {
+            a
+            for a, (ax, ay) in xy.items()
+            if any(
+                b != a and math.hypot(ax - bx, ay - by) < p.update_clearance
+                for b, (bx, by) in xy.items()
+            )
+        }
+        her = self._named
+        ev = self._tracks.get(her) if her is not None else None
+        if her is None or ev is None or her not in xy:
+            return
+        face = ev.face(p.face_recent)
+        if face is None or face >= p.face_distance:
+            return
+        if not any(tid == her and detected for tid, _, _, detected in tracks):
+            return
+        hx, hy = xy[her]
+        for tid, x, y, detected in tracks:
+            if tid == her or not detected or math.hypot(x - hx, y - hy) < p.coexist_distance:
+                continue
+            other = self._tracks.setdefault(tid, _Evidence())
+            if other.distractor is None and not other.face_distances:
+                other.distractor = "coexisted"
+            if other.distractor is not None:
+                self.distractors.remember(tid, (x, y), t, "coexisted", other.upper, other.lower)
 
     def identity(self, track_id: int) -> TrackIdentity | None:
         """The latest identity of a track (None if never observed or forgotten)."""
@@ -469,22 +722,45 @@ class TargetIdentifier:
         return dict(self._latest)
 
     def target_track(self) -> int | None:
-        """The track that is the target: among tracks decided TARGET, a face-confirmed one before
-        a clothes-only one, then the higher confidence, then the most recently seen; None if no
-        track is decided TARGET."""
-        best: tuple[tuple[int, float, float], int] | None = None
+        """The track named the target (:meth:`_name`: kept while the tracker holds it, switched
+        only on a face match or a confirmed identification); None: she is lost."""
+        return self._named if self._named in self._latest else None
+
+    def candidate_track(self) -> int | None:
+        """An ambiguous person worth going to see the face of (issue 23, item 3): a track with
+        legs, not named, not decided NOT_TARGET, whose clothes match hers (so only a face can
+        tell: a look-alike may be about, or it is not confirmed yet), not known to be someone
+        else, its face not yet seen; the most recently seen first. None when she is named, or
+        no one is ambiguous."""
+        if self.target_track() is not None:
+            return None
+        p = self.params
+        best: tuple[float, int] | None = None
         for tid, ident in self._latest.items():
-            if ident.decision is not Decision.TARGET:
-                continue
-            key = (int(ident.basis == "face"), ident.confidence, ident.last_seen)
-            if best is None or key > best[0]:
-                best = (key, tid)
+            ev = self._tracks[tid]
+            if (
+                ident.decision is not Decision.NOT_TARGET
+                and ident.legs_seen
+                and not ev.face_distances
+                and ev.distractor is None
+                and ident.clothes_similarity is not None
+                and ident.clothes_similarity >= p.clothes_similarity
+                and (best is None or ident.last_seen > best[0])
+            ):
+                best = (ident.last_seen, tid)
         return None if best is None else best[1]
 
+    def known_tracks(self) -> set[int]:
+        """The tracks the identifier holds anything about (to :meth:`forget` when deleted)."""
+        return set(self._tracks) | set(self._latest)
+
     def forget(self, track_id: int) -> None:
-        """Drop a track's evidence (the tracker deleted it)."""
+        """Drop a track's evidence (the tracker deleted it); a distractor stays remembered."""
         self._tracks.pop(track_id, None)
         self._latest.pop(track_id, None)
+        self.distractors.track_ended(track_id)
+        if self._named == track_id:
+            self._named = None
 
 
 __all__ = ["Decision", "FaceSearchStats", "TargetIdentifier", "TrackIdentity"]

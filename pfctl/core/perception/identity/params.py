@@ -9,6 +9,7 @@ from typing import Literal
 from pfctl.core.params import param
 from pfctl.core.perception.clothes import ClothesParams
 from pfctl.core.perception.faces import FaceParams
+from pfctl.core.perception.identity.log_odds import LogOddsWeights
 
 FaceTiming = Literal["deterministic", "realtime"]
 """When a face worker's results are folded in (:mod:`pfctl.core.perception.identity.identifier`)."""
@@ -37,6 +38,12 @@ class IdentityParams:
     benchmarks/bench_identity.py measures it)."""
     face_recheck_s: float = 1.0
     """How often a settled track's face is embedded again, seconds."""
+    face_recent: int = param(
+        5,
+        "A track's face evidence is the median distance of its newest this many face samples"
+        " (a track swapped onto someone else shows it within a few faces).",
+        ge=1,
+    )
     face_miss_limit: int = param(
         3,
         "After this many face searches of a track in a row found no face (the back of the head),"
@@ -66,6 +73,48 @@ class IdentityParams:
         "Deterministic timing: the latency of a face search (about one embedding).",
         unit="s",
         ge=0,
+    )
+
+    weights: LogOddsWeights = field(default_factory=LogOddsWeights)
+    """How much each cue moves a track's log-odds of being the target
+    (:mod:`~pfctl.core.perception.identity.log_odds`)."""
+    confirm_frames: int = param(
+        5,
+        "A new track is named the target without a face match only after this many camera"
+        " frames in a row at the accepting log-odds (OCL-RPF's confirmation).",
+        ge=1,
+    )
+    confirm_s: float = param(
+        2.0,
+        "... and over at least this long (time for the robot to go and see the face).",
+        unit="s",
+        ge=0,
+    )
+    look_alike_memory_s: float = param(
+        120.0,
+        "After a person in her clothes was found not to be her (by face, or seen beside her),"
+        " her clothes are no evidence for this long (a look-alike is about).",
+        unit="s",
+        ge=0,
+    )
+    coexist_distance: float = param(
+        1.0,
+        "A person tracked this far or farther from her face-confirmed track at the same time is"
+        " not her.",
+        unit="m",
+        gt=0,
+    )
+    update_clearance: float = param(
+        1.0,
+        "Her appearance model learns from a frame only when no other person is this close.",
+        unit="m",
+        ge=0,
+    )
+    update_rate: float = param(
+        0.1,
+        "How much one frame moves her online appearance model (0: never learn online).",
+        ge=0,
+        le=1,
     )
 
     @property
