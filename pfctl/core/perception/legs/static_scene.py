@@ -9,9 +9,10 @@ grid for the leg detector, in the fixed frame the scans are posed in (the robot 
 does not), with occupancy counted in **seconds**, not scans, so any laser at any rate builds the
 same scene:
 
-- every cell holds the seconds of evidence that it is occupied, from 0 to
-  :data:`MEMORY_FACTOR` × ``static_after_s``: a scan adds its period (the time since the
-  previous scan, at most :data:`MAX_PERIOD_S`) to the cells of its returns and takes
+- every cell holds the seconds of evidence that it is occupied, from −M to M =
+  :data:`MEMORY_FACTOR` × ``static_after_s`` (negative: seen free): a scan adds its period (the
+  time since the previous scan folded in, at most :data:`MAX_PERIOD_S`; scans come in at most
+  every :data:`FOLD_PERIOD_S`) to the cells of its returns (from at least 0) and takes
   :data:`FREE_RATE` × its period from the cells its beams pass through before their return;
 - a cell is **static** once it holds ``static_after_s`` seconds: a wall or a chair seen from a
   moving robot gets there, a walking person's leg (a cell hit for a fraction of a second, then
@@ -40,6 +41,9 @@ RESOLUTION = 0.1
 WINDOW_M = 24.0
 #: A scan's period counts at most this much (a gap in the scans is no evidence), s.
 MAX_PERIOD_S = 0.5
+#: Scans are folded in at most this often, each with the time since the last one folded: the
+#: scene changes over seconds, so a 40 Hz laser costs what a 10 Hz one does, s.
+FOLD_PERIOD_S = 0.1
 #: A beam passing through a cell takes this many seconds per second of evidence away.
 FREE_RATE = 1.0
 #: A cell remembers at most this many times ``static_after_s`` (a wall seen for a minute comes
@@ -154,10 +158,15 @@ class StaticScene:
         cells its beams cross before their return."""
         pose = scan.pose
         self._follow(pose.x, pose.y)
-        period = 0.0 if self._last_stamp is None else scan.stamp - self._last_stamp
-        period = min(max(period, 0.0), MAX_PERIOD_S)
+        if self._last_stamp is None or scan.stamp < self._last_stamp:
+            self._last_stamp = scan.stamp
+            return
+        period = scan.stamp - self._last_stamp
+        if period < FOLD_PERIOD_S - 1e-9:
+            return
         self._last_stamp = scan.stamp
-        if period == 0.0 or len(scan.ranges) == 0:
+        period = min(period, MAX_PERIOD_S)
+        if len(scan.ranges) == 0:
             return
         ranges = np.asarray(scan.ranges, dtype=float)
         with np.errstate(invalid="ignore"):
