@@ -13,7 +13,7 @@ import pytest
 
 from pfctl.core.perception.legs.detector import LegDetector, LegParams
 from pfctl.core.perception.pipeline import CAMERA_MAX_AGE, SINGLE_LEG_DISTANCE, Perception
-from pfctl.core.perception.tracking import MultiPersonTracker
+from pfctl.core.perception.tracking import MultiPersonTracker, TrackStatus
 from pfctl.core.perception.vision import PersonDetection
 from pfctl.core.robot import CameraInfo, LaserScan, Pose2D, RgbdFrame
 
@@ -119,3 +119,14 @@ def test_a_stale_camera_detection_makes_no_candidate() -> None:
     _run(perception, frame_lag=CAMERA_MAX_AGE + 0.02)
     (track,) = perception.tracks(confirmed_only=False)
     assert not perception.has_legs(track.id)
+
+
+def test_with_the_static_scene_filter_a_person_standing_still_keeps_her_track() -> None:
+    """Her cells stay occupied for 3 s, longer than ``static_after_s``: as a tracked person her
+    segment is spared (and kept out of the scene), so her track is still seen at the end."""
+    legs = LegDetector(FixedScore(), LegParams(history_scans=1, static_after_s=0.5))  # type: ignore[arg-type]
+    perception = Perception(legs, MultiPersonTracker(), detector=SeesAt(HER))
+    _run(perception, seconds=3.0)
+    (track,) = perception.tracks()
+    assert track.status is TrackStatus.CONFIRMED and track.last_seen == pytest.approx(2.925)
+    assert math.dist(track.position, HER) < 0.1

@@ -13,7 +13,10 @@ legs close together are one person. Here:
 gives
    P(leg), averaged over the last ``history_scans`` scans of the segment's track when that is
    more than 1 (:class:`~pfctl.core.perception.legs.evidence.LegEvidence`); segments with P ≥
-   ``probability`` are legs;
+   ``probability`` are legs — with ``static_after_s`` > 0, not those on the static scene (cells
+   of the fixed frame seen occupied that long,
+   :class:`~pfctl.core.perception.legs.static_scene.StaticScene`) unless beside a person already
+   tracked;
 4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
    (greedy matching by distance), into person candidates at the midpoint; a leg left alone
    with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
