@@ -1,12 +1,13 @@
 """Speed of the laser perception per scan on one CPU core: leg detection + tracking, 10 people.
 
-Run ``python benchmarks/bench_perception.py [--runs N]``. It feeds the 1081-beam crowd scan of
-``bench_legs.py`` (10 people 1–5 m ahead) to
+Run ``python benchmarks/bench_perception.py [--runs N] [--static-after S]``. It feeds the
+1081-beam crowd scan of ``bench_legs.py`` (10 people 1–5 m ahead) to
 :meth:`pfctl.core.perception.pipeline.Perception.on_scan` at 40 Hz stamps — leg detection with the
 shipped model, then the tracker's predict, Hungarian association and Kalman updates — and prints the
 median, 90th and 99th percentiles in milliseconds after the ten tracks are confirmed. Goal (issue
-5): under 3 ms a scan. The belief update is timed by ``bench_tracking_belief.py``. It asserts
-nothing about time.
+5): under 3 ms a scan. ``--static-after S`` turns the static-scene filter on
+(``perception.legs.static_after_s``). The belief update is timed by ``bench_tracking_belief.py``.
+It asserts nothing about time.
 """
 
 from __future__ import annotations
@@ -36,9 +37,20 @@ HOUSE = Path(__file__).resolve().parents[1] / "missions" / "house.yaml"
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=1000, help="timed scans")
+    parser.add_argument(
+        "--static-after",
+        type=float,
+        default=0.0,
+        help="perception.legs.static_after_s (the static-scene filter; 0: the mission's default)",
+    )
     args = parser.parse_args()
     scan = crowd_scan(10)
-    perception = build_perception(load_mission(HOUSE))
+    mission = load_mission(HOUSE)
+    if args.static_after > 0:
+        legs = mission.perception.legs.model_copy(update={"static_after_s": args.static_after})
+        perception_cfg = mission.perception.model_copy(update={"legs": legs})
+        mission = mission.model_copy(update={"perception": perception_cfg})
+    perception = build_perception(mission)
     for k in range(40):  # one second to confirm the tracks
         perception.on_scan(replace(scan, stamp=k / 40))
     times = []

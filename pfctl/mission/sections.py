@@ -172,6 +172,7 @@ class LegsConfig(CoreSection, core=LegParams):
     max_range: FromCore
     pair_distance: FromCore
     history_scans: FromCore
+    static_after_s: FromCore
 
     @field_validator("model")
     @classmethod

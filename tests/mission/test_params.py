@@ -66,7 +66,7 @@ def test_every_core_key_has_the_core_default_and_meaning() -> None:
             assert field.default == core.default, f"{section.__name__}.{key}"
             assert field.description == param_info(source, name).describe()
             keys += 1
-    assert keys == 59
+    assert keys == 60
 
 
 def test_the_default_mission_builds_the_core_defaults() -> None:
@@ -117,6 +117,16 @@ perception: {identity: {bins: [8, 8, 8], face_miss_limit: 5}}
     }
     identity = identity_params(mission)
     assert identity.clothes == ClothesParams("hsv", (8, 8, 8)) and identity.face_miss_limit == 5
+
+
+def test_the_static_scene_filter_is_off_by_default_and_a_mission_turns_it_on() -> None:
+    assert leg_params(loads_mission(MINIMAL)).static_after_s == 0.0
+    on = loads_mission(MINIMAL + "perception: {legs: {static_after_s: 0.5}}\n")
+    assert leg_params(on).static_after_s == 0.5
+    with pytest.raises(
+        MissionError, match=r"perception\.legs\.static_after_s: expected a value >= 0"
+    ):
+        loads_mission(MINIMAL + "perception: {legs: {static_after_s: -1}}\n")
 
 
 def test_face_timing_auto_is_deterministic_in_the_simulator_and_realtime_on_a_robot() -> None:

@@ -99,7 +99,10 @@ class Perception:
 
     def on_scan(self, scan: LaserScan) -> LegDetections:
         """Detect legs in ``scan`` and update the tracks with the person candidates."""
-        found = self.legs.detect(scan)
+        tracked = None
+        if self.legs.scene is not None:  # the static-scene filter spares the tracked people
+            tracked = np.array([t.position for t in self.tracks()], dtype=float).reshape(-1, 2)
+        found = self.legs.detect(scan, tracked)
         detections = [Detection(p.x, p.y, p.probability) for p in found.people]
         detections += self._legs_beside_camera_people(found)
         ids = self.tracker.update("laser", detections, FieldOfView.from_scan(scan), scan.stamp)

@@ -200,3 +200,14 @@ def test_a_track_is_confirmed_on_scans_alone_within_one_tick() -> None:
     (track,) = perception.tracks()
     assert track.status is TrackStatus.CONFIRMED
     assert track.position == pytest.approx((0.4 * 0.1 + 2.0, 0.0), abs=0.02)
+
+
+def test_with_the_static_scene_filter_a_person_standing_still_keeps_her_track() -> None:
+    """Her cells stay occupied for 3 s, longer than ``static_after_s``: as a tracked person her
+    segment is spared (and kept out of the scene), so her track is still seen at the end."""
+    legs = LegDetector(FixedScore(), LegParams(history_scans=1, static_after_s=0.5))  # type: ignore[arg-type]
+    perception = Perception(legs, MultiPersonTracker(), detector=SeesAt(HER))
+    _run(perception, seconds=3.0)
+    (track,) = perception.tracks()
+    assert track.status is TrackStatus.CONFIRMED and track.last_seen == pytest.approx(2.925)
+    assert math.dist(track.position, HER) < 0.1

@@ -13,7 +13,10 @@ legs close together are one person. Here:
 gives
    P(leg), averaged over the last ``history_scans`` scans of the segment's track when that is
    more than 1 (:class:`~pfctl.core.perception.legs.evidence.LegEvidence`); segments with P ≥
-   ``probability`` are legs;
+   ``probability`` are legs — with ``static_after_s`` > 0, not those on the static scene (cells
+   of the fixed frame seen occupied that long,
+   :class:`~pfctl.core.perception.legs.static_scene.StaticScene`) unless beside a person already
+   tracked;
 4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
    (greedy matching by distance), into person candidates at the midpoint; a leg left alone
    with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
@@ -39,6 +42,7 @@ from pfctl.core.perception.legs.features import (
     segment_scan,
 )
 from pfctl.core.perception.legs.model import LegModel
+from pfctl.core.perception.legs.static_scene import StaticScene
 from pfctl.core.robot import LaserScan
 
 #: From a leg's visible surface to its axis along the beam, metres (≈ 0.75 × a 6 cm leg radius:
@@ -46,6 +50,9 @@ from pfctl.core.robot import LaserScan
 LEG_DEPTH = 0.045
 #: A candidate from one leg gets this fraction of the leg's probability.
 SINGLE_LEG_FACTOR = 0.5
+#: A segment whose centroid is this close to a tracked person is that person's: never static
+#: scene, and its returns are not folded into the scene, m.
+TRACKED_RADIUS = 0.5
 _DISTANCE = FEATURE_NAMES.index("distance")
 
 
@@ -84,6 +91,14 @@ class LegParams:
         "P(leg) of a segment is averaged over this many scans of its track (1: each scan alone).",
         ge=1,
         le=100,
+    )
+    static_after_s: float = param(
+        0.0,
+        "Segments on cells of the fixed frame that the laser has seen occupied for this long"
+        " (walls, furniture: the static scene) are no legs, unless beside a tracked person"
+        " (0: off).",
+        unit="s",
+        ge=0,
     )
 
 
@@ -197,20 +212,29 @@ class LegDetector:
         self.evidence = (
             LegEvidence(self.params.history_scans) if self.params.history_scans > 1 else None
         )
+        self.scene = (
+            StaticScene(self.params.static_after_s) if self.params.static_after_s > 0 else None
+        )
 
     def reset(self) -> None:
-        """Forget the segments of earlier scans."""
+        """Forget the segments and the scene of earlier scans."""
         if self.evidence is not None:
             self.evidence.reset()
+        if self.scene is not None:
+            self.scene.reset()
 
-    def detect(self, scan: LaserScan) -> LegDetections:
+    def detect(self, scan: LaserScan, tracked: np.ndarray | None = None) -> LegDetections:
         """Legs (P ≥ ``probability``) and the people they make in one scan, and the lone legs
-        (:attr:`LegDetections.lone_legs`)."""
+        (:attr:`LegDetections.lone_legs`). ``tracked``: where the people already tracked are
+        ``(k, 2)``, map frame — with ``static_after_s`` their segments are never static scene
+        (:mod:`~pfctl.core.perception.legs.static_scene`)."""
         c = classify_segments(scan, self.model, self.params)
         if self.evidence is not None:
             seen = np.flatnonzero(c.classified)
             where = scan.pose.transform(c.segments.centroids()[seen])
             c.probability[seen] = self.evidence.update(where, c.probability[seen])
+        if self.scene is not None:
+            self._drop_static(scan, c, tracked)
         low = min(self.params.probability, self.params.lone_leg_probability)
         idx = np.flatnonzero(c.classified & (c.probability >= low))
         if len(idx) == 0:
@@ -245,9 +269,35 @@ class LegDetector:
         ]
         return LegDetections(scan.stamp, legs, tuple(people), tuple(lone))
 
+    def _drop_static(
+        self, scan: LaserScan, c: ClassifiedSegments, tracked: np.ndarray | None
+    ) -> None:
+        """P(leg) = 0 for the segments on the static scene, then the scan folded into it (the
+        returns of segments beside ``tracked`` people left out of both)."""
+        assert self.scene is not None
+        segs = c.segments
+        near = np.zeros(len(segs), dtype=bool)
+        if tracked is not None and len(tracked) and len(segs):
+            centres = scan.pose.transform(segs.centroids())
+            pts = np.asarray(tracked, dtype=float).reshape(-1, 2)
+            d = np.hypot(
+                centres[:, None, 0] - pts[None, :, 0], centres[:, None, 1] - pts[None, :, 1]
+            )
+            near = (d < TRACKED_RADIUS).any(axis=1)
+        if len(segs):
+            static = self.scene.static_segments(
+                scan.pose.transform(segs.xy), segs.start, segs.count
+            )
+            c.probability[static & ~near] = 0.0
+        keep_out = np.zeros(len(scan.ranges), dtype=bool)
+        if near.any():
+            keep_out[segs.beam[np.repeat(near, segs.count)]] = True
+        self.scene.update(scan, keep_out)
+
 
 __all__ = [
     "LEG_DEPTH",
+    "TRACKED_RADIUS",
     "ClassifiedSegments",
     "Leg",
     "LegDetections",
