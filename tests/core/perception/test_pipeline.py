@@ -140,9 +140,12 @@ def test_a_stale_camera_detection_makes_no_candidate() -> None:
 
 
 class PersonAhead:
-    """A leg detector that finds one person 2 m ahead of each scan's laser pose."""
+    """A leg detector that finds one person 2 m ahead of each scan's laser pose (no static-scene
+    filter, as the shipped detector by default)."""
 
-    def detect(self, scan: LaserScan) -> LegDetections:
+    scene = None
+
+    def detect(self, scan: LaserScan, tracked: np.ndarray | None = None) -> LegDetections:
         x, y = scan.pose.x + 2.0, scan.pose.y
         return LegDetections(scan.stamp, (), (PersonCandidate(x, y, 0.9, ()),))
 
