@@ -82,6 +82,20 @@ def nearest_viewpoint(
     least path cost (ties: the one nearer the person); None when no viewpoint can be reached
     (or the robot is nowhere near a free cell)."""
     mask = viewpoint_mask(planner, person_xy, range_max, range_min, clearance)
+    rows, cols = np.indices(planner.geometry.shape)
+    centres = planner.geometry.cell_to_world(rows, cols)
+    away = np.linalg.norm(centres - np.asarray(person_xy, dtype=float).reshape(2), axis=-1)
+    return _cheapest(planner, robot_xy, mask, away)
+
+
+def _cheapest(
+    planner: GridPlanner,
+    robot_xy: ArrayLike,
+    mask: NDArray[np.bool_],
+    tie: NDArray[np.float64],
+) -> Viewpoint | None:
+    """Of the cells in ``mask``, the one the robot at ``robot_xy`` reaches at the least path
+    cost, ties to the least ``tie`` (per cell); None when none can be reached."""
     if not mask.any():
         return None
     try:
@@ -91,12 +105,9 @@ def nearest_viewpoint(
     rows, cols = np.nonzero(mask & np.isfinite(cost))
     if len(rows) == 0:
         return None
-    centres = planner.geometry.cell_to_world(rows, cols)
-    away = np.linalg.norm(centres - np.asarray(person_xy, dtype=float).reshape(2), axis=1)
-    best = int(np.lexsort((away, cost[rows, cols]))[0])
-    return Viewpoint(
-        (float(centres[best, 0]), float(centres[best, 1])), float(cost[rows, cols][best])
-    )
+    best = int(np.lexsort((tie[rows, cols], cost[rows, cols]))[0])
+    xy = planner.geometry.cell_to_world(rows[best], cols[best])
+    return Viewpoint((float(xy[0]), float(xy[1])), float(cost[rows[best], cols[best]]))
 
 
 def face_viewpoint(
@@ -123,18 +134,7 @@ def face_viewpoint(
     bearing = np.arctan2(centres[..., 1] - py, centres[..., 0] - px)
     off = np.abs((bearing - facing + math.pi) % (2 * math.pi) - math.pi)
     mask &= (off <= half_angle) & (off >= aside)
-    if not mask.any():
-        return None
-    try:
-        cost = planner.distances_from(robot_xy)
-    except NoPathError:
-        return None
-    r, c = np.nonzero(mask & np.isfinite(cost))
-    if len(r) == 0:
-        return None
-    best = int(np.lexsort((off[r, c], cost[r, c]))[0])
-    xy = centres[r[best], c[best]]
-    return Viewpoint((float(xy[0]), float(xy[1])), float(cost[r[best], c[best]]))
+    return _cheapest(planner, robot_xy, mask, off)
 
 
 __all__ = ["Viewpoint", "face_viewpoint", "nearest_viewpoint", "viewpoint_mask"]
