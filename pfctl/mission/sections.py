@@ -225,6 +225,7 @@ class TrackingConfig(CoreSection, core=TrackerParams):
     camera_noise: FromCore
     gate: FromCore
     confirm_hits: FromCore
+    confirm_s: FromCore
     tentative_timeout_s: FromCore
     max_coast_s: FromCore
     max_coast_unseen_s: FromCore

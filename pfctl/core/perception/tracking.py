@@ -28,8 +28,11 @@ Associated tracks are corrected; the other detections start tentative tracks.
 
 **Life cycle** (ids are consecutive integers from 1, never reused):
 
-* TENTATIVE → CONFIRMED once it has ``confirm_hits`` detections (the one that created it counts);
-  a tentative track unseen for ``tentative_timeout_s`` is deleted, so a lone spurious detection
+* TENTATIVE → CONFIRMED once it has ``confirm_hits`` detections (the one that created it counts)
+  spread over at least ``confirm_s`` seconds, so a 40 Hz laser, a 7.5 Hz one and a replay that
+  repeats each scan confirm a person after the same time, not after the same number of scans
+  (counted in updates only, 3 hits were 75 ms at 40 Hz: clutter and a track started between two
+  people confirmed within one tick); a tentative track unseen for ``tentative_timeout_s`` is deleted, so a lone spurious detection
   never confirms (dense random clutter can chain up inside the growing gates: see the benchmark).
 * A confirmed track that a sensor's update does not associate becomes COASTING (prediction only,
   its covariance grows) when the track is inside that sensor's field of view (a miss), or when that
@@ -201,6 +204,13 @@ class TrackerParams:
     confirm_hits: int = param(
         3, "A tentative track is confirmed after this many associated detections.", ge=1
     )
+    confirm_s: float = param(
+        0.2,
+        "... and its detections span at least this long since the first one (3 hits at 10 Hz):"
+        " a person is confirmed after the same time at any scan rate.",
+        unit="s",
+        ge=0,
+    )
     tentative_timeout_s: float = param(
         0.5, "A tentative track unseen for this long is deleted.", unit="s", gt=0
     )
@@ -235,6 +245,8 @@ class TrackerParams:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"TrackerParams.{name} must be > 0, got {value}")
+        if not (math.isfinite(self.confirm_s) and self.confirm_s >= 0):
+            raise ValueError(f"TrackerParams.confirm_s must be ≥ 0, got {self.confirm_s}")
         if self.confirm_hits < 1:
             raise ValueError(f"TrackerParams.confirm_hits must be ≥ 1, got {self.confirm_hits}")
         unknown = set(self.spawn_sensors) - set(SENSORS)
@@ -298,6 +310,7 @@ class _Entry:
     last_seen: float
     confidence: float
     last_seen_by: dict[str, float]
+    first_seen: float
 
     def snapshot(self) -> Track:
         x = self.kf.x
@@ -474,7 +487,7 @@ class MultiPersonTracker:
             entry.last_seen = now
             entry.last_seen_by[sensor] = now
             entry.confidence += CONFIDENCE_RATE * (detections[j].confidence - entry.confidence)
-            if entry.status is TrackStatus.COASTING or entry.hits >= p.confirm_hits:
+            if entry.status is TrackStatus.COASTING or self._confirms(entry, now):
                 entry.status = TrackStatus.CONFIRMED
             associated.add(i)
             out[j] = entry.id
@@ -508,16 +521,23 @@ class MultiPersonTracker:
                         id=next(self._ids),
                         kf=self._new_filter((d.x, d.y), sigma),
                         status=TrackStatus.CONFIRMED
-                        if p.confirm_hits <= 1
+                        if p.confirm_hits <= 1 and p.confirm_s <= 0
                         else TrackStatus.TENTATIVE,
                         hits=1,
                         last_seen=now,
                         confidence=CONFIDENCE_RATE * d.confidence,
                         last_seen_by={sensor: now},
+                        first_seen=now,
                     )
                     self._entries.append(entry)
                     out[j] = entry.id
         return out
+
+    def _confirms(self, entry: _Entry, now: float) -> bool:
+        """A tentative track with ``confirm_hits`` detections over at least ``confirm_s``."""
+        p = self.params
+        # 1e-9: stamps summed from a scan period (k · 0.025) must not miss the bound by rounding.
+        return entry.hits >= p.confirm_hits and now - entry.first_seen >= p.confirm_s - 1e-9
 
     def _associate(self, z: NDArray[np.float64], R: NDArray[np.float64]) -> list[tuple[int, int]]:
         """(track index, detection index) pairs: Hungarian assignment minimising the total

@@ -191,18 +191,22 @@ def test_each_scan_of_an_observation_updates_the_tracker_at_its_stamp_frame_amon
     np.testing.assert_allclose(stamps, [0.025, 0.05, 0.06, 0.075, 0.1])
 
 
-def test_a_track_is_confirmed_on_scans_alone_within_one_tick() -> None:
-    """``confirm_hits`` scans at 40 Hz confirm a person within one 10 Hz tick (one scan per
-    tick took ``confirm_hits`` ticks), at the position of the newest scan's detection."""
+def test_a_track_is_confirmed_after_confirm_s_whatever_the_scans_per_tick() -> None:
+    """Four scans per tick give four updates, but the track is confirmed only once its
+    detections span ``confirm_s`` (0.2 s): at the third tick, as with one scan per tick, not
+    within the first (``confirm_hits`` scans at 40 Hz are 75 ms); at the newest scan's position."""
     tracker = CountingTracker()
-    hits = tracker.params.confirm_hits
-    assert hits <= 4
+    assert tracker.params.confirm_s == pytest.approx(0.2)
     perception = Perception(PersonAhead(), tracker)  # type: ignore[arg-type]
-    perception.on_observation(_tick(0.1, frame=False))
-    assert len(tracker.updates) == 4
-    (track,) = perception.tracks()
-    assert track.status is TrackStatus.CONFIRMED
-    assert track.position == pytest.approx((0.4 * 0.1 + 2.0, 0.0), abs=0.02)
+    statuses = []
+    for t in (0.1, 0.2, 0.3):
+        perception.on_observation(_tick(t, frame=False))
+        (track,) = tracker.tracks()
+        statuses.append(track.status)
+    assert len(tracker.updates) == 12
+    assert statuses == [TrackStatus.TENTATIVE, TrackStatus.TENTATIVE, TrackStatus.CONFIRMED]
+    assert perception.tracks() == [track]
+    assert track.position == pytest.approx((0.4 * 0.3 + 2.0, 0.0), abs=0.02)
 
 
 def test_with_the_static_scene_filter_a_person_standing_still_keeps_her_track() -> None:

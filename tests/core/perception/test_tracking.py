@@ -209,7 +209,7 @@ def test_track_out_of_every_view_is_deleted_after_max_coast_unseen_s() -> None:
 
 
 def test_tentative_until_confirm_hits() -> None:
-    tracker = MultiPersonTracker(TrackerParams(confirm_hits=3))
+    tracker = MultiPersonTracker(TrackerParams(confirm_hits=3, confirm_s=0.0))
     statuses = []
     for k in range(4):
         (the_id,) = tracker.update(LASER, dets([(1.0, 2.0)]), ALL_AROUND, k * DT)
@@ -217,6 +217,37 @@ def test_tentative_until_confirm_hits() -> None:
         statuses.append(tracker.track(1).status)  # type: ignore[union-attr]
     assert statuses == [TrackStatus.TENTATIVE, TrackStatus.TENTATIVE] + [TrackStatus.CONFIRMED] * 2
     assert tracker.tracks(confirmed_only=True)[0].hits == 4
+
+
+@pytest.mark.parametrize("rate_hz", [7.5, 10.0, 37.5, 40.0])
+def test_a_person_is_confirmed_after_confirm_s_at_any_scan_rate(rate_hz: float) -> None:
+    """``confirm_hits`` and ``confirm_s`` together: the first update at or after 0.2 s from the
+    first detection confirms (3 hits at 7.5 Hz take 0.27 s, so there the hits decide)."""
+    tracker = MultiPersonTracker(TrackerParams(confirm_hits=3, confirm_s=0.2))
+    k = 0
+    while (track := tracker.track(1)) is None or track.status is TrackStatus.TENTATIVE:
+        tracker.update(LASER, dets([(1.0, 2.0)]), ALL_AROUND, k / rate_hz)
+        k += 1
+    expected = max(3, math.ceil(0.2 * rate_hz - 1e-9) + 1)
+    assert k == expected and (k - 1) / rate_hz >= 0.2 - 1e-9
+
+
+def test_a_repeated_scan_does_not_confirm_clutter_within_one_real_scan_period() -> None:
+    """A 7.5 Hz laser replayed with each scan copied five times (37.5 Hz stamps): one spurious
+    detection in one real scan gives five updates within 0.13 s and must stay tentative, then
+    go when unseen for ``tentative_timeout_s``."""
+    tracker = MultiPersonTracker(TrackerParams())
+    for k in range(5):
+        tracker.update(LASER, dets([(3.0, -1.0)]), ALL_AROUND, k / 37.5)
+    assert tracker.track(1).status is TrackStatus.TENTATIVE  # type: ignore[union-attr]
+    for k in range(5, 30):
+        tracker.update(LASER, [], ALL_AROUND, k / 37.5)
+    assert tracker.track(1) is None and tracker.tracks(confirmed_only=True) == []
+
+
+def test_confirm_s_must_not_be_negative() -> None:
+    with pytest.raises(ValueError, match="confirm_s"):
+        TrackerParams(confirm_s=-0.1)
 
 
 def test_clutter_never_confirms_and_ids_are_never_reused() -> None:
