@@ -32,8 +32,9 @@ Associated tracks are corrected; the other detections start tentative tracks.
   spread over at least ``confirm_s`` seconds, so a 40 Hz laser, a 7.5 Hz one and a replay that
   repeats each scan confirm a person after the same time, not after the same number of scans
   (counted in updates only, 3 hits were 75 ms at 40 Hz: clutter and a track started between two
-  people confirmed within one tick); a tentative track unseen for ``tentative_timeout_s`` is deleted, so a lone spurious detection
-  never confirms (dense random clutter can chain up inside the growing gates: see the benchmark).
+  people confirmed within one tick); a tentative track unseen for ``tentative_timeout_s`` is
+  deleted, so a lone spurious detection never confirms (dense random clutter can chain up inside
+  the growing gates: see the benchmark).
 * A confirmed track that a sensor's update does not associate becomes COASTING (prediction only,
   its covariance grows) when the track is inside that sensor's field of view (a miss), or when that
   sensor was the last to see it (it left the view and no other sensor has it). A track outside the
