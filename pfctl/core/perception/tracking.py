@@ -207,8 +207,9 @@ class TrackerParams:
     )
     confirm_s: float = param(
         0.2,
-        "... and its detections span at least this long since the first one (3 hits at 10 Hz):"
-        " a person is confirmed after the same time at any scan rate.",
+        "A tentative track is confirmed only once its detections span at least this long since"
+        " the first one (3 hits at 10 Hz), so a person is confirmed after the same time at any"
+        " scan rate.",
         unit="s",
         ge=0,
     )
