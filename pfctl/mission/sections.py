@@ -205,6 +205,7 @@ class IdentityConfig(CoreSection, core=(IdentityParams, ClothesParams)):
     not inline in the tick (``pfctl follow``/``search`` in the simulator)."""
     face_timing: FromCore
     face_latency_s: FromCore
+    min_face_px: FromCore
     face_miss_limit: FromCore
     face_miss_backoff_s: FromCore
 

@@ -202,6 +202,8 @@ class FaceSearchStats:
     """Worker results whose track was deleted meanwhile."""
     backed_off: int = 0
     """Searches skipped because the track's searches kept missing (``face_miss_limit``)."""
+    too_small: int = 0
+    """Faces found but smaller than ``min_face_px``: not used as evidence."""
     waited_s: float = 0.0
     """Wall time spent waiting for the worker (deterministic timing), seconds."""
     clothes_measured: int = 0
@@ -503,6 +505,9 @@ class TargetIdentifier:
     def _fold_face(
         self, ev: _Evidence, stamp: float, embedding: np.ndarray, box: Box | None, now: float
     ) -> None:
+        if box is not None and box[3] - box[1] < self.params.min_face_px:
+            self.face_stats.too_small += 1  # too far to tell: neither a match nor a mismatch
+            return
         d = self.profile.face_distance(embedding)
         if d is None:
             return

@@ -44,6 +44,14 @@ class IdentityParams:
         " (a track swapped onto someone else shows it within a few faces).",
         ge=1,
     )
+    min_face_px: int = param(
+        12,
+        "Faces less than this many pixels high (far from the camera) are too coarse to tell her"
+        " from others and are not used as evidence. In the simulator at 320x240, her own face"
+        " 4 m away (10-11 px) lies 0.56-0.66 from her profile, at 2.4-3.2 m (14-18 px) 0.3-0.4.",
+        unit="px",
+        ge=0,
+    )
     face_miss_limit: int = param(
         3,
         "After this many face searches of a track in a row found no face (the back of the head),"
