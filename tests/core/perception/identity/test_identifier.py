@@ -427,3 +427,19 @@ def test_someone_in_her_clothes_without_a_face_is_the_candidate_to_go_and_see(le
     assert ident.candidate_track() == 4
     assert ident.observe(4, 0.2, True, *_at(_picture(RED, TARGET_FACE), 2.0, 2.0)).basis == "face"
     assert ident.target_track() == 4 and ident.candidate_track() is None
+
+
+def test_a_face_too_small_to_tell_is_no_evidence_either_way(learned) -> None:
+    """A face under ``min_face_px`` (far away: dlib's embedding of a 10-px face put the target's
+    own face 0.56-0.66 from her profile) neither matches nor rejects: a mismatching face that
+    small does not make the person a distractor, and clothes decide as if no face were seen."""
+    profile, params, encoder = learned
+    coarse = replace(params, min_face_px=500)  # every face here is "too small"
+    ident = TargetIdentifier(profile, coarse, encoder)
+    seen = ident.observe(2, 0.0, True, *reversed(_picture(RED, OTHER_FACE)))
+    assert ident.face_stats.too_small == 1 and seen.face_samples == 0
+    assert seen.decision is not Decision.NOT_TARGET and seen.basis == "clothes"
+    assert 2 not in ident.distractors.people
+    default = TargetIdentifier(profile, params, encoder)
+    rejected = default.observe(2, 0.0, True, *reversed(_picture(RED, OTHER_FACE)))
+    assert rejected.decision is Decision.NOT_TARGET and default.face_stats.too_small == 0
