@@ -324,9 +324,9 @@ class Follower:
     def _fit_prediction(self, now: float, seen: Sighting) -> PredictionState | None:
         """§II-E: fit the mission's predictor to the last ``history_s`` of the detected path
         (the paper's weighted SVR), predict ``horizon_s`` ahead, clip to the map, and move the
-        end into free space for the robot. With ``search.strategy`` belief the place to go is
-        the predicted room's doorway instead (:meth:`_predicted_room`), also when the path is
-        too short to fit."""
+        end into free space for the robot. With ``search.prediction_goal`` room the place to
+        go is the predicted room's doorway instead (:meth:`_predicted_room`), also when the
+        path is too short to fit."""
         p = self.params.prediction
         room = self._predicted_room(now)
         h = seen.history
@@ -359,11 +359,11 @@ class Follower:
         return state
 
     def _predicted_room(self, now: float) -> tuple[tuple[float, float], str] | None:
-        """With ``search.strategy`` belief: the most probable room a few seconds on and where
-        to look into it from (its doorway on the robot's way; the last sighting when she is
-        most likely still in the robot's room or her own). None with the paper's strategy."""
+        """With ``search.prediction_goal`` room: the most probable room a few seconds on and
+        where to look into it from (its doorway on the robot's way; the last sighting when she
+        is most likely still in the robot's room or her own). None with ``path``."""
         whereabouts = self.world.whereabouts
-        if self.params.search.strategy != "belief" or whereabouts is None:
+        if self.params.search.prediction_goal != "room" or whereabouts is None:
             return None
         ranked = whereabouts.ranked(now + self.params.room_horizon_s)
         if not ranked or whereabouts.start is None:

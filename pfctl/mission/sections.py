@@ -291,6 +291,7 @@ class SearchConfig(CoreSection, core=SearchParams):
     min_frontier_cells: FromCore
     waypoint_choice: FromCore
     strategy: FromCore
+    prediction_goal: FromCore
     look_s: FromCore
 
 

@@ -275,6 +275,10 @@ SearchStrategy = Literal["belief", "paper"]
 """How the lost target is looked for (:class:`SearchParams.strategy`)."""
 SEARCH_STRATEGIES: tuple[SearchStrategy, ...] = ("belief", "paper")
 
+PredictionGoal = Literal["path", "room"]
+"""Where go_to_prediction drives (:class:`SearchParams.prediction_goal`)."""
+PREDICTION_GOALS: tuple[PredictionGoal, ...] = ("path", "room")
+
 
 @dataclass(frozen=True)
 class SearchParams:
@@ -295,11 +299,17 @@ class SearchParams:
     )
     strategy: SearchStrategy = param(
         "paper",
-        "How the lost target is looked for: ``paper`` (the paper literally: the prediction's end"
-        " point, then Algorithm 1's way-points) or ``belief`` (where she can be, spread along the"
+        "How way-point search looks for the lost target: ``paper`` (the paper literally:"
+        " Algorithm 1's way-points) or ``belief`` (where she can be, spread along the"
         " doors since she was last seen and emptied where the camera looked; the next place is"
         " the most probable room over the time to get there and look, from its doorway first;"
-        " the prediction goes to the predicted room; ``missions/house_belief_search.yaml``).",
+        " ``missions/house_belief_search.yaml``).",
+    )
+    prediction_goal: PredictionGoal = param(
+        "path",
+        "Where go_to_prediction drives after a loss: ``path`` (§II-E, the paper: the end of"
+        " her predicted path, clipped to the map) or ``room`` (the doorway of the room the"
+        " belief over where she can be ranks first a few seconds on).",
     )
     look_s: float = param(
         6.0,
