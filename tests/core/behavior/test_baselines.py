@@ -198,6 +198,36 @@ def test_the_cv_baseline_predicts_at_constant_velocity_where_the_svr_bends() -> 
     assert not np.allclose(paths["svr"], paths["cv"], atol=0.05)
 
 
+def test_the_prediction_goal_is_the_path_end_or_the_likely_rooms_doorway() -> None:
+    # Up the hall toward the office door at 0.4 m/s, lost at t = 3 (the robot in the kitchen).
+    t = np.linspace(0.0, 3.0, 31)
+    path = np.column_stack([t, np.full_like(t, 3.9), 4.5 + 0.4 * t])
+    seen = Sighting(3.0, (3.9, 5.7), path)
+    goals = {}
+    for goal in ("path", "room"):
+        mission = load_mission(MISSIONS / "house.yaml")
+        search = mission.search.model_copy(update={"strategy": "belief", "prediction_goal": goal})
+        mission = mission.model_copy(update={"search": search})
+        follower = build_follower(mission, _Idle(), _Idle())  # type: ignore[arg-type]
+        try:
+            follower.robot_pose = (2.5, 2.0)
+            follower._lost(3.0, seen)
+            state = follower._fit_prediction(3.1, seen)
+        finally:
+            follower.close()
+        assert state is not None
+        goals[goal] = state
+    # path (the paper, whatever the way-point strategy): where her predicted path ends, on
+    # past the office door into the office
+    end = goals["path"]
+    assert end.goal[1] > 6.0 and math.dist(end.goal, tuple(end.path[-1])) < 0.5
+    # room: the office (the belief's first room), looked into from its doorway
+    door = goals["room"]
+    assert door.region == "office"
+    assert math.dist(door.goal, (3.95, 6.0)) < 0.3
+    assert math.dist(end.goal, door.goal) > 0.5
+
+
 # --------------------------------------------------------------------------------------------
 # the reactive and go-to-last-seen trees on the real leaves
 # --------------------------------------------------------------------------------------------
