@@ -8,7 +8,9 @@
   annotated people against time, with the misses, false positives and switches marked) together,
   so an error or Ctrl-C leaves nothing half-written. ``--decimate N`` keeps every N-th scan and
   ``--spread K`` repeats each kept scan K times with its stamps spread to the next one: the same
-  bag at other rates.
+  bag at other rates. ``--min-bearing A --max-bearing B`` (degrees, laser frame) score only the
+  annotations and tracks within that wedge, where the annotator marked people (the benchmark's
+  own script scores ``general_tracking_moving`` within −80° to 12°).
 """
 
 from __future__ import annotations
@@ -37,7 +39,13 @@ def _finite(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def _metrics(bag: Path, ground_truth: str, radius: float, ev: TrackEvaluation) -> dict[str, object]:
+def _metrics(
+    bag: Path,
+    ground_truth: str,
+    radius: float,
+    bearings: tuple[float, float] | None,
+    ev: TrackEvaluation,
+) -> dict[str, object]:
     r = ev.result
     return {
         "bag": str(bag),
@@ -45,6 +53,7 @@ def _metrics(bag: Path, ground_truth: str, radius: float, ev: TrackEvaluation) -
         "scan_topic": ev.scan_topic,
         "frame": ev.frame,
         "radius": radius,
+        "bearings_deg": None if bearings is None else list(bearings),
         **{k: _finite(v) if isinstance(v, float) else v for k, v in r.as_dict().items()},
         "scans": len(ev.tracks),
         "unpaired_annotated_scans": ev.unpaired,
@@ -88,10 +97,28 @@ def evaluate(
             "--spread", min=1, help="Repeat each scan K times, stamps spread to the next one."
         ),
     ] = 1,
+    min_bearing: Annotated[
+        float,
+        typer.Option(
+            "--min-bearing", help="Score only people and tracks at bearings from this, degrees."
+        ),
+    ] = -180.0,
+    max_bearing: Annotated[
+        float,
+        typer.Option(
+            "--max-bearing", help="Score only people and tracks at bearings up to this, degrees."
+        ),
+    ] = 180.0,
 ) -> None:
     """Score the tracker on a bag with annotated people (CLEAR-MOT)."""
     if not (math.isfinite(radius) and radius > 0):
         raise UserError(f"--radius: expected a distance > 0 m, got {radius:g}")
+    if not -180.0 <= min_bearing < max_bearing <= 180.0:
+        raise UserError(
+            f"--min-bearing/--max-bearing: expected −180 ≤ min < max ≤ 180 degrees, got "
+            f"{min_bearing:g} and {max_bearing:g}"
+        )
+    wedge = None if (min_bearing, max_bearing) == (-180.0, 180.0) else (min_bearing, max_bearing)
     mission = evaluation_mission(mission_path)
     check_output_dir(out, "--out")
     console = Console(stderr=True)
@@ -104,10 +131,11 @@ def evaluate(
         radius=radius,
         decimate=decimate,
         spread=spread,
+        bearings=None if wedge is None else (math.radians(wedge[0]), math.radians(wedge[1])),
         progress=lambda total: progress_bar(console, "replaying", total),
     )
     r = ev.result
-    metrics = _metrics(bag, ground_truth, radius, ev)
+    metrics = _metrics(bag, ground_truth, radius, wedge, ev)
     png = tracking_figure(
         [(p.time, p.ids, p.xy) for p in ev.truth],
         [(s.stamp, s.ids, s.xy) for s in ev.tracks],
@@ -120,11 +148,13 @@ def evaluate(
     atomic_write_all(
         [(out / "metrics.json", json.dumps(metrics, indent=2) + "\n"), (out / "tracks.png", png)]
     )
+    within = "" if wedge is None else f", bearings {wedge[0]:g}° to {wedge[1]:g}°"
     print(
         f"{bag.name}: MOTA {100 * r.mota:.1f} %, MOTP {r.motp:.3f} m, misses {r.misses}, "
         f"false positives {r.false_positives}, ID switches {r.id_switches}, "
         f"ground truth {r.ground_truth} at {r.frames} annotated scans "
-        f"(radius {radius:g} m, frame {ev.frame!r}) → {out / 'metrics.json'}, {out / 'tracks.png'}"
+        f"(radius {radius:g} m, frame {ev.frame!r}{within}) → {out / 'metrics.json'}, "
+        f"{out / 'tracks.png'}"
     )
     if ev.unpaired:
         print(

@@ -173,6 +173,7 @@ class LegsConfig(CoreSection, core=LegParams):
     pair_distance: FromCore
     history_scans: FromCore
     static_after_s: FromCore
+    weak_probability: FromCore
 
     @field_validator("model")
     @classmethod

@@ -1,6 +1,7 @@
 """CLEAR-MOT of the shipped perception on the shared annotated real bag (Leigh et al.'s
 ``general_tracking_moving_1.bag``: a moving robot among people, 7.5 Hz), at its native rate, at
-half the rate and with each scan spread to five times the rate; and the thinning itself.
+half the rate and with each scan spread to five times the rate, scored where the bag is
+annotated (:data:`BEARINGS`) unless said; and the thinning itself.
 
 The bag is read once per module (about 5 s: its ``/tf``); each scoring then replays its 873 scans
 (2-4 s), or the annotated stretch of them. Skipped when ``../shared/data/legs`` is absent.
@@ -8,6 +9,7 @@ The bag is read once per module (about 5 s: its ``/tf``); each scoring then repl
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Any
 
@@ -43,11 +45,30 @@ def annotated() -> tuple[list[LaserScan], list[AnnotatedPeople]]:
 
 
 #: The settings for real lasers (benchmarks/README.md, "People tracking on a real annotated
-#: bag"): the static-scene filter and the lower leg threshold it makes affordable.
+#: bag"): the static-scene filter, a lower leg threshold, and dual thresholds (weak candidates
+#: keep tracks going, a track is confirmed by two detections 0.2 s apart).
 REAL_LASER = {
-    "perception": {"legs": {"static_after_s": 0.5, "history_scans": 1, "probability": 0.2}},
-    "tracking": {"process_noise": 1.0, "laser_noise": 0.15, "max_coast_s": 3.0},
+    "perception": {
+        "legs": {
+            "static_after_s": 0.5,
+            "history_scans": 1,
+            "probability": 0.2,
+            "weak_probability": 0.25,
+        }
+    },
+    "tracking": {
+        "process_noise": 1.0,
+        "laser_noise": 0.15,
+        "max_coast_s": 3.0,
+        "confirm_hits": 2,
+    },
 }
+
+#: Where the bag's people are annotated, bearings in the laser's frame (radians): the benchmark's
+#: own CLEAR-MOT script scores this bag within −80° to 12° only (angusleigh/leg_tracker_benchmarks,
+#: ``clear_mot/launch/tracking_benchmarks/general_tracking_moving_joint_leg.launch``); people
+#: walking beside and behind the robot, outside it, are not annotated.
+BEARINGS = (math.radians(-80.0), math.radians(12.0))
 
 
 def _mission(settings: dict[str, Any] | None) -> Mission:
@@ -64,20 +85,24 @@ def _score(
     spread: int = 1,
     warm_up: float | None = None,
     settings: dict[str, Any] | None = None,
+    bearings: tuple[float, float] | None = BEARINGS,
 ) -> TrackEvaluation:
-    """The perception's score (shipped defaults, or ``settings``); with ``warm_up`` only the
-    scans from that many seconds before the first annotation to the last one are replayed."""
+    """The perception's score (shipped defaults, or ``settings``) within ``bearings`` (default:
+    the annotated wedge); with ``warm_up`` only the scans from that many seconds before the
+    first annotation to the last one are replayed."""
     scans, annotations = annotated
     if warm_up is not None:
         t0, t1 = annotations[0].time - warm_up, annotations[-1].time + 0.1
         scans = [s for s in scans if t0 <= s.stamp <= t1]
     perception = build_perception(_mission(settings))
-    return score_scans(scans, annotations, perception, decimate=decimate, spread=spread)
+    return score_scans(
+        scans, annotations, perception, decimate=decimate, spread=spread, bearings=bearings
+    )
 
 
 @pytest.fixture(scope="module")
 def native(annotated: tuple[list[LaserScan], list[AnnotatedPeople]]) -> TrackEvaluation:
-    return _score(annotated)
+    return _score(annotated, bearings=None)
 
 
 def test_every_annotation_of_the_real_bag_is_scored_at_its_scan(native: TrackEvaluation) -> None:
@@ -96,21 +121,29 @@ def test_the_shipped_perception_holds_its_floor_on_the_real_annotated_bag(
     assert r.motp <= 0.15, r
 
 
-def test_the_static_scene_filter_and_a_low_leg_threshold_hold_their_floor_on_the_real_bag(
+def test_the_real_laser_settings_hold_their_floor_where_the_real_bag_is_annotated(
     annotated: tuple[list[LaserScan], list[AnnotatedPeople]],
 ) -> None:
-    """The real-laser settings (:data:`REAL_LASER`): above the shipped defaults' floor, and the
-    filter is what makes the low threshold pay (the same without it scores less)."""
+    """The real-laser settings (:data:`REAL_LASER`) scored as the benchmark scores this bag
+    (within :data:`BEARINGS`): MOTA at least 25 % (Leigh et al. report 10.2 % for their joint
+    leg tracker, counting false positives at unannotated scans too), and the dual thresholds
+    are what lift it (without them, with three hits to confirm, it scores 4 points less)."""
     r = _score(annotated, settings=REAL_LASER).result
-    assert r.mota >= 0.10, r
+    assert r.ground_truth == 133, r
+    assert r.mota >= 0.25, r
     assert r.id_switches <= 2, r
     assert r.motp <= 0.15, r
-    legs = REAL_LASER["perception"]["legs"]
-    unfiltered = {**REAL_LASER, "perception": {"legs": {**legs, "static_after_s": 0.0}}}
-    assert _score(annotated, settings=unfiltered).result.mota < r.mota - 0.03
+    legs, tracking = REAL_LASER["perception"]["legs"], REAL_LASER["tracking"]
+    single = {
+        "perception": {"legs": {**legs, "weak_probability": 1.0}},
+        "tracking": {**tracking, "confirm_hits": 3},
+    }
+    assert _score(annotated, settings=single).result.mota < r.mota - 0.04
 
 
-@pytest.mark.parametrize("settings", [None, REAL_LASER], ids=["shipped", "real-laser"])
+@pytest.mark.parametrize(
+    ("settings", "bearings"), [(None, None), (REAL_LASER, BEARINGS)], ids=["shipped", "real-laser"]
+)
 @pytest.mark.parametrize(
     ("decimate", "spread"), [(2, 1), pytest.param(1, 5, marks=pytest.mark.slow)]
 )
@@ -119,14 +152,19 @@ def test_half_the_rate_or_five_times_it_scores_within_5_points_of_the_native_rat
     decimate: int,
     spread: int,
     settings: dict[str, Any] | None,
+    bearings: tuple[float, float] | None,
 ) -> None:
     """3.75 Hz, and 37.5 Hz (each scan five times, stamps spread): the annotated stretch of the
-    bag from 5 s before its first annotation (the 37.5 Hz replay takes about 7 s). With the
-    real-laser settings too: there five copies of a scan confirmed clutter within one real scan
-    period while confirmation counted hits (5.9 points below native); ``confirm_s`` counts
-    seconds."""
-    native = _score(annotated, warm_up=5.0, settings=settings)
-    other = _score(annotated, decimate, spread, warm_up=5.0, settings=settings)
+    bag from 5 s before its first annotation (the 37.5 Hz replay takes about 7 s); the shipped
+    defaults over the whole view (within :data:`BEARINGS` they find 7 of the 133 people at 7.5
+    Hz and none at 3.75 Hz: 5.3 points), the real-laser settings within :data:`BEARINGS`.
+    With the real-laser settings: there five copies of a scan confirmed
+    clutter within one real scan period while confirmation counted hits (5.9 points below
+    native; ``confirm_s`` counts seconds), and at 3.75 Hz the static-scene filter called a
+    standing person's cells static after two scans while counting a whole scan period for a
+    cell's first hit (13 points below native)."""
+    native = _score(annotated, warm_up=5.0, settings=settings, bearings=bearings)
+    other = _score(annotated, decimate, spread, warm_up=5.0, settings=settings, bearings=bearings)
     assert abs(other.result.mota - native.result.mota) <= 0.05, (other.result, native.result)
 
 

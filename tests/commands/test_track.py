@@ -53,6 +53,7 @@ def test_evaluate_scores_the_annotated_scans_and_writes_metrics_and_a_picture(
         (["--ground-truth", PEOPLE, "--radius", "0"], "--radius: expected a distance > 0 m"),
         (["--ground-truth", PEOPLE, "--radius", "-1"], "--radius: expected a distance > 0 m"),
         (["--ground-truth", PEOPLE, "--scan-topic", "/nope"], "no topic /nope"),
+        (["--ground-truth", PEOPLE, "--min-bearing", "10", "--max-bearing", "0"], "min < max"),
     ],
 )
 def test_bad_input_is_one_line_exit_2_and_no_files(

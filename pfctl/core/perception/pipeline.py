@@ -105,6 +105,7 @@ class Perception:
         found = self.legs.detect(scan, tracked)
         detections = [Detection(p.x, p.y, p.probability) for p in found.people]
         detections += self._legs_beside_camera_people(found)
+        detections += [Detection(p.x, p.y, p.probability, spawn=False) for p in found.weak]
         ids = self.tracker.update("laser", detections, FieldOfView.from_scan(scan), scan.stamp)
         self._leg_tracks.update(i for i in ids if i is not None)
         self._forget_deleted()

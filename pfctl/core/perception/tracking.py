@@ -24,7 +24,10 @@ whose squared Mahalanobis distance ``νᵀ S⁻¹ ν`` with ``S = H P Hᵀ + R``
 (the total distance is minimised among the assignments with the most gated pairs) — first for
 the confirmed and coasting tracks, then for the tentative ones with the detections left (the
 matching cascade of SORT-style trackers: a young track never takes a known person's detection).
-Associated tracks are corrected; the other detections start tentative tracks.
+Associated tracks are corrected; the other detections start tentative tracks, except weak
+ones (``Detection.spawn`` False), which are dropped: dual thresholds, a confident detection
+starts a track and a weaker one only keeps a track going (Leigh et al. 2015 likewise associate
+leg clusters of any confidence with the existing tracks but start tracks only from some).
 
 **Life cycle** (ids are consecutive integers from 1, never reused):
 
@@ -107,6 +110,9 @@ class Detection:
     x: float
     y: float
     confidence: float = 1.0
+    spawn: bool = True
+    """Whether the detection may start a track; False: a weak detection, which may only update
+    a track whose gate it falls in (dual thresholds)."""
 
 
 @dataclass(frozen=True)
@@ -518,7 +524,7 @@ class MultiPersonTracker:
 
         if sensor in p.spawn_sensors:
             for j, d in enumerate(detections):
-                if out[j] is None:
+                if out[j] is None and d.spawn:
                     entry = _Entry(
                         id=next(self._ids),
                         kf=self._new_filter((d.x, d.y), sigma),

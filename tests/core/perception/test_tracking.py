@@ -245,6 +245,21 @@ def test_a_repeated_scan_does_not_confirm_clutter_within_one_real_scan_period() 
     assert tracker.track(1) is None and tracker.tracks(confirmed_only=True) == []
 
 
+def test_weak_detections_keep_a_track_going_but_never_start_one() -> None:
+    """Dual thresholds: a detection with ``spawn`` False updates the track in whose gate it
+    falls (and confirms it like any other) but starts none where no track is."""
+    tracker = MultiPersonTracker(TrackerParams(confirm_hits=2, confirm_s=0.2))
+    assert tracker.update(LASER, [Detection(5.0, 5.0, 0.1, spawn=False)], ALL_AROUND, 0.0) == [None]
+    assert len(tracker) == 0
+    assert tracker.update(LASER, dets([(1.0, 2.0)]), ALL_AROUND, 0.0) == [1]
+    k = 1
+    while (track := tracker.track(1)) is not None and track.status is TrackStatus.TENTATIVE:
+        weak = [Detection(1.0 + 0.01 * k, 2.0, 0.1, spawn=False), Detection(4.0, 0.0, 0.1, False)]
+        assert tracker.update(LASER, weak, ALL_AROUND, k / 7.5) == [1, None]
+        k += 1
+    assert k == 3 and len(tracker) == 1  # confirmed at 0.27 s by weak detections; none started
+
+
 def test_confirm_s_must_not_be_negative() -> None:
     with pytest.raises(ValueError, match="confirm_s"):
         TrackerParams(confirm_s=-0.1)

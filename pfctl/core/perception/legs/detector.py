@@ -20,7 +20,11 @@ gives
 4. :func:`pair_legs` matches legs closer than ``pair_distance`` two by two, closest pairs first
    (greedy matching by distance), into person candidates at the midpoint; a leg left alone
    with P ≥ ``single_leg_probability`` is a candidate too (a person with one leg occluded), with
-   its confidence halved; the other lone legs are reported apart (``lone_legs``).
+   its confidence halved; the other lone legs are reported apart (``lone_legs``);
+5. with ``weak_probability`` < 1 (dual thresholds), the segments with P ≥ ``weak_probability``
+   that made no candidate are paired the same way into weak candidates (``weak``), which may
+   keep a track going but not start one
+   (:class:`~pfctl.core.perception.tracking.Detection`'s ``spawn``).
 
 Legs and people are reported in the map frame (through ``scan.pose``). A leg's position is its
 segment's centroid moved :data:`LEG_DEPTH` farther along the beam: the laser sees the front of
@@ -29,7 +33,7 @@ the leg, its axis is behind.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -86,6 +90,15 @@ class LegParams:
     its P(leg) is at least this, also below ``probability``: beside a person the camera sees it
     is that person's, and the camera's detection is the evidence the forest's score lacks (a
     target standing side-on shows one segment for both legs, scored about 0.3-0.6)."""
+    weak_probability: float = param(
+        1.0,
+        "Dual thresholds: a segment with at least this P(leg) that made no person candidate"
+        " (below ``probability``, or a lone leg below ``single_leg_probability``) is a weak"
+        " candidate, paired with a weak neighbour as legs are: it may update the track of a"
+        " person already tracked but never starts one (1: off).",
+        gt=0,
+        le=1,
+    )
     history_scans: int = param(
         10,
         "P(leg) of a segment is averaged over this many scans of its track (1: each scan alone).",
@@ -134,6 +147,9 @@ class LegDetections:
     ``lone_leg_probability`` up to ``probability`` — one segment of a person standing side-on,
     or clutter (a table's leg). Alone they are no one; the perception counts one beside a
     person the camera sees (:class:`~pfctl.core.perception.pipeline.Perception`)."""
+    weak: tuple[PersonCandidate, ...] = ()
+    """Weak candidates (``weak_probability``): segments that made no candidate, paired as legs
+    are; the tracker lets them update a track but not start one."""
 
 
 @dataclass(frozen=True)
@@ -235,7 +251,9 @@ class LegDetector:
             c.probability[seen] = self.evidence.update(where, c.probability[seen])
         if self.scene is not None:
             self._drop_static(scan, c, tracked)
-        low = min(self.params.probability, self.params.lone_leg_probability)
+        low = min(
+            self.params.probability, self.params.lone_leg_probability, self.params.weak_probability
+        )
         idx = np.flatnonzero(c.classified & (c.probability >= low))
         if len(idx) == 0:
             return LegDetections(scan.stamp, (), ())
@@ -267,7 +285,33 @@ class LegDetector:
             for (x, y), p in zip(found[~is_leg], p_found[~is_leg], strict=True)
             if p >= self.params.lone_leg_probability
         ]
-        return LegDetections(scan.stamp, legs, tuple(people), tuple(lone))
+        weak = self._weak_candidates(found, p_found, np.flatnonzero(is_leg)[list(grouped)])
+        return LegDetections(scan.stamp, legs, tuple(people), tuple(lone), weak)
+
+    def _weak_candidates(
+        self, xy: np.ndarray, probability: np.ndarray, used: np.ndarray
+    ) -> tuple[PersonCandidate, ...]:
+        """The weak candidates (``weak_probability``) among the segments at ``xy`` with
+        ``probability`` not ``used`` by a candidate: paired as :func:`pair_legs` pairs legs,
+        every one left alone a candidate too (with half its P(leg), as a lone leg)."""
+        if self.params.weak_probability >= 1.0:
+            return ()
+        free = np.ones(len(xy), dtype=bool)
+        free[used.astype(np.intp)] = False
+        idx = np.flatnonzero(free & (probability >= self.params.weak_probability))
+        if len(idx) == 0:
+            return ()
+        pts, prob = xy[idx], probability[idx]
+        out = []
+        for group in pair_legs(pts, prob, replace(self.params, single_leg_probability=0.0)):
+            g = list(group)
+            p = float(prob[g].mean()) * (SINGLE_LEG_FACTOR if len(g) == 1 else 1.0)
+            mid = pts[g].mean(axis=0)
+            legs = tuple(
+                Leg(float(x), float(y), float(q)) for (x, y), q in zip(pts[g], prob[g], strict=True)
+            )
+            out.append(PersonCandidate(float(mid[0]), float(mid[1]), p, legs))
+        return tuple(out)
 
     def _drop_static(
         self, scan: LaserScan, c: ClassifiedSegments, tracked: np.ndarray | None

@@ -12,7 +12,10 @@ same scene:
 - every cell holds the seconds of evidence that it is occupied, from −M to M =
   :data:`MEMORY_FACTOR` × ``static_after_s`` (negative: seen free): a scan adds its period (the
   time since the previous scan folded in, at most :data:`MAX_PERIOD_S`; scans come in at most
-  every :data:`FOLD_PERIOD_S`) to the cells of its returns (from at least 0) and takes
+  every :data:`FOLD_PERIOD_S`) to the cells of its returns that the previous folds left
+  occupied (from at least 0; a cell seen occupied for the first time holds no duration yet: it
+  is known occupied from this scan on, and counting a whole period for it made a 3.75 Hz laser
+  call a cell static after two scans, 0.27 s apart, where a 7.5 Hz one needed four) and takes
   :data:`FREE_RATE` × its period from the cells its beams pass through before their return;
 - a cell is **static** once it holds ``static_after_s`` seconds: a wall or a chair seen from a
   moving robot gets there, a walking person's leg (a cell hit for a fraction of a second, then
@@ -53,6 +56,9 @@ MEMORY_FACTOR = 2.0
 STATIC_FRACTION = 0.5
 #: Beams without a return clear the cells up to this far, m (or the laser's range_max).
 NO_RETURN_FREE_M = 8.0
+
+#: The evidence of a cell seen occupied for the first time: positive (occupied now), no duration.
+_JUST_HIT = 1e-9
 
 _NEIGHBOURS = np.array([(dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1)])
 
@@ -195,8 +201,12 @@ class StaticScene:
         # a cell listed twice gets the same value twice: no need for unique indices
         memory = MEMORY_FACTOR * self.static_after_s
         flat = self.seconds.reshape(-1)
+        # A cell seen occupied now has been occupied since the last scan that saw it so (its
+        # evidence positive), not for a whole period: a first hit is no duration yet.
+        was_occupied = flat[hits] > 0.0
         flat[free] = np.maximum(flat[free] - FREE_RATE * period, -memory)
-        flat[hits] = np.minimum(np.maximum(flat[hits], 0.0) + period, memory)
+        held = np.minimum(np.maximum(flat[hits], 0.0) + period, memory)
+        flat[hits] = np.where(was_occupied, held, _JUST_HIT)
 
     def _flat(self, xy: NDArray[np.float64]) -> NDArray[np.intp]:
         """Flat indices of the window's cells holding points ``xy`` (outside: dropped)."""
