@@ -277,7 +277,6 @@ SEARCH_STRATEGIES: tuple[SearchStrategy, ...] = ("belief", "paper")
 
 PredictionGoal = Literal["path", "room"]
 """Where go_to_prediction drives (:class:`SearchParams.prediction_goal`)."""
-PREDICTION_GOALS: tuple[PredictionGoal, ...] = ("path", "room")
 
 
 @dataclass(frozen=True)
