@@ -32,7 +32,7 @@ every tick has one) and by whether the tick did face work (inline: a face was em
 worker: a head crop was submitted), and each tick's time is broken into the tick's stages —
 timed by calling them one after the other, as ``Follower.tick`` does (:func:`staged_tick`) — and
 the work inside them, timed by wrapping a few methods in this process only (laser perception,
-leg detection, camera perception, person detection, Algorithm 2 identification, face detection
+leg classification of the tick's scans, leg detection, camera perception, person detection, Algorithm 2 identification, face detection
 and embedding with dlib when inline, the worker's submit and poll, tracking, belief update,
 occupancy grid update, behavior tree, Algorithm 1, the gaze rule, calls into the robot, Python's
 garbage collector): per stage how many ticks ran it, its median and p99 when it ran, and its
@@ -100,6 +100,12 @@ TICK_STAGES = ("observe", "perceive", "predict", "decide", "act", "log")
 #: None for a module function, attribute). The indentation says which stage (or inner work) a
 #: label runs in.
 INNER: tuple[tuple[str, str, str | None, str], ...] = (
+    (
+        "  leg classification (a tick's scans)",
+        "pfctl.core.perception.legs.detector",
+        "LegDetector",
+        "classify",
+    ),
     ("  laser perception (on_scan)", "pfctl.core.perception.pipeline", "Perception", "on_scan"),
     ("    leg detection", "pfctl.core.perception.legs.detector", "LegDetector", "detect"),
     ("  camera perception (on_frame)", "pfctl.core.perception.pipeline", "Perception", "on_frame"),

@@ -170,6 +170,7 @@ class LegsConfig(CoreSection, core=LegParams):
     jump_distance: FromCore
     min_points: FromCore
     max_range: FromCore
+    max_width: FromCore
     pair_distance: FromCore
     history_scans: FromCore
     static_after_s: FromCore

@@ -39,7 +39,12 @@ from numpy.typing import NDArray
 from pfctl.core.episode import TrackRow
 from pfctl.core.perception.belief import HumanBelief
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier, TrackIdentity
-from pfctl.core.perception.legs.detector import SINGLE_LEG_FACTOR, LegDetections, LegDetector
+from pfctl.core.perception.legs.detector import (
+    SINGLE_LEG_FACTOR,
+    ClassifiedSegments,
+    LegDetections,
+    LegDetector,
+)
 from pfctl.core.perception.tracking import (
     Detection,
     FieldOfView,
@@ -97,12 +102,16 @@ class Perception:
         """The belief grid's cells the last frame saw (Eq. 4's visible mask; None without a
         belief or a frame yet)."""
 
-    def on_scan(self, scan: LaserScan) -> LegDetections:
-        """Detect legs in ``scan`` and update the tracks with the person candidates."""
+    def on_scan(
+        self, scan: LaserScan, classified: ClassifiedSegments | None = None
+    ) -> LegDetections:
+        """Detect legs in ``scan`` and update the tracks with the person candidates.
+        ``classified``: the scan's segments as :meth:`LegDetector.classify` gave them with the
+        other scans of a tick (None: classified here)."""
         tracked = None
         if self.legs.scene is not None:  # the static-scene filter spares the tracked people
             tracked = np.array([t.position for t in self.tracks()], dtype=float).reshape(-1, 2)
-        found = self.legs.detect(scan, tracked)
+        found = self.legs.detect(scan, tracked, classified)
         detections = [Detection(p.x, p.y, p.probability) for p in found.people]
         detections += self._legs_beside_camera_people(found)
         detections += [Detection(p.x, p.y, p.probability, spawn=False) for p in found.weak]

@@ -145,7 +145,9 @@ class PersonAhead:
 
     scene = None
 
-    def detect(self, scan: LaserScan, tracked: np.ndarray | None = None) -> LegDetections:
+    def detect(
+        self, scan: LaserScan, tracked: np.ndarray | None = None, classified: object = None
+    ) -> LegDetections:
         x, y = scan.pose.x + 2.0, scan.pose.y
         return LegDetections(scan.stamp, (), (PersonCandidate(x, y, 0.9, ()),))
 

@@ -15,9 +15,12 @@ All coordinates are in the laser's own frame (x ahead, y left); beams are in sca
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+from pfctl.core.robot import LaserScan
 
 #: Feature order of :func:`segment_features` (the columns of its matrix). A leg model stores
 #: the names it was trained with and is refused when they differ (``leg_model``).
@@ -57,12 +60,15 @@ NEIGHBOUR_RADIUS = 1.0
 class Segments:
     """The segments of one scan: returns ``xy`` ``(n, 2)`` (laser frame, scan order) and each
     segment's first index ``start`` and length ``count`` into them, plus the beam index of every
-    return (``beam``)."""
+    return (``beam``). Segments of several scans, one scan after the other
+    (:func:`segment_scans`), carry each segment's scan index in ``scan``."""
 
     xy: np.ndarray
     beam: np.ndarray
     start: np.ndarray
     count: np.ndarray
+    scan: np.ndarray | None = None
+    """``(k,)``: the scan of each segment (0, 1, …), or None: all of one scan."""
 
     def __len__(self) -> int:
         return len(self.start)
@@ -78,13 +84,45 @@ class Segments:
             return np.empty((0, 2))
         return np.add.reduceat(self.xy, self.start, axis=0) / self.count[:, None]
 
+    def widths(self) -> np.ndarray:
+        """Each segment's width ``(k,)``: from its first return to its last, m."""
+        last = self.start + self.count - 1
+        return np.hypot(*(self.xy[last] - self.xy[self.start]).T)
 
-def valid_returns(ranges: np.ndarray, range_min: float, range_max: float) -> np.ndarray:
+    def subset(self, which: np.ndarray) -> Segments:
+        """The segments at the indices ``which`` (ascending), with only their returns."""
+        count = self.count[which]
+        if len(count) == len(self.count):
+            return self
+        total = int(count.sum())
+        start = np.concatenate(([0], np.cumsum(count)[:-1])).astype(np.intp)
+        rows = np.arange(total) + np.repeat(self.start[which] - start, count)
+        scan = None if self.scan is None else self.scan[which]
+        return Segments(self.xy[rows], self.beam[rows], start, count, scan)
+
+    def split(self, scans: int) -> list[tuple[slice, Segments]]:
+        """Per scan of ``scans``: which of these segments are its (a slice) and its segments
+        alone, as :func:`segment_scan` gives them."""
+        if self.scan is None:
+            return [(slice(0, len(self)), self)]
+        bounds = np.concatenate(([0], np.cumsum(np.bincount(self.scan, minlength=scans))))
+        ends = np.append(self.start, len(self.xy))
+        out = []
+        for a, b in zip(bounds[:-1].tolist(), bounds[1:].tolist(), strict=True):
+            p, q = int(ends[a]), int(ends[b])
+            segs = Segments(self.xy[p:q], self.beam[p:q], self.start[a:b] - p, self.count[a:b])
+            out.append((slice(a, b), segs))
+        return out
+
+
+def valid_returns(
+    ranges: np.ndarray, range_min: float | np.ndarray, range_max: float | np.ndarray
+) -> np.ndarray:
     """Which beams returned: finite and within ``[range_min, range_max]`` (REP-117; real drivers
     also write 0 or −inf for no return)."""
     r = np.asarray(ranges, dtype=float)
     with np.errstate(invalid="ignore"):
-        return np.isfinite(r) & (r >= max(range_min, 1e-6)) & (r <= range_max)
+        return np.isfinite(r) & (r >= np.maximum(range_min, 1e-6)) & (r <= range_max)
 
 
 def segment_scan(
@@ -105,22 +143,73 @@ def segment_scan(
     is in exactly one segment (segments of one point included; the detector drops the short
     ones).
     """
-    r = np.asarray(ranges, dtype=float)
-    ok = valid_returns(r, range_min, range_max)
-    beam = np.flatnonzero(ok)
-    a = angle_min + angle_increment * beam
-    xy = np.column_stack((r[beam] * np.cos(a), r[beam] * np.sin(a)))
-    if len(beam) == 0:
+    return _segment(
+        np.asarray(ranges, dtype=float),
+        None,
+        angle_min,
+        angle_increment,
+        range_min,
+        range_max,
+        jump_distance,
+    )
+
+
+def segment_scans(scans: Sequence[LaserScan], jump_distance: float) -> Segments:
+    """:func:`segment_scan` of several scans in one pass: their segments one scan after the
+    other, each segment's scan in :attr:`Segments.scan` (a segment never spans two scans).
+    :meth:`Segments.split` gives each scan's segments as :func:`segment_scan` would."""
+    sizes = [len(s.ranges) for s in scans]
+    scan = np.repeat(np.arange(len(scans)), sizes)
+
+    def per_beam(values: list[float]) -> np.ndarray:
+        return np.asarray(values, dtype=float)[scan]
+
+    return _segment(
+        np.concatenate([np.asarray(s.ranges, dtype=float) for s in scans]),
+        scan,
+        per_beam([s.angle_min for s in scans]),
+        per_beam([s.angle_increment for s in scans]),
+        per_beam([s.range_min for s in scans]),
+        per_beam([s.range_max for s in scans]),
+        jump_distance,
+        offsets=np.cumsum([0, *sizes[:-1]]),
+    )
+
+
+def _segment(
+    r: np.ndarray,
+    scan: np.ndarray | None,
+    angle_min: float | np.ndarray,
+    angle_increment: float | np.ndarray,
+    range_min: float | np.ndarray,
+    range_max: float | np.ndarray,
+    jump_distance: float,
+    offsets: np.ndarray | None = None,
+) -> Segments:
+    """Segments of the beams ``r`` of one scan (``scan`` None, the parameters scalars) or of
+    several scans joined (``scan``: each beam's scan, the parameters per beam, ``offsets``:
+    each scan's first beam in ``r``); a new scan always starts a new segment."""
+    flat = np.flatnonzero(valid_returns(r, range_min, range_max))
+    if scan is None:
+        beam, a = flat, angle_min + angle_increment * flat
+    else:
+        assert offsets is not None
+        beam = flat - offsets[scan[flat]]
+        a = np.asarray(angle_min)[flat] + np.asarray(angle_increment)[flat] * beam
+    xy = np.column_stack((r[flat] * np.cos(a), r[flat] * np.sin(a)))
+    if len(flat) == 0:
         empty = np.empty(0, dtype=np.intp)
-        return Segments(xy, beam, empty, empty)
+        return Segments(xy, beam, empty, empty, None if scan is None else empty)
     jump = np.hypot(*np.diff(xy, axis=0).T) >= jump_distance
+    if scan is not None:
+        jump |= scan[flat[1:]] != scan[flat[:-1]]
     breaks = np.flatnonzero(jump) + 1
     start = np.concatenate(([0], breaks)).astype(np.intp)
     count = np.diff(np.concatenate((start, [len(beam)]))).astype(np.intp)
-    return Segments(xy, beam, start, count)
+    return Segments(xy, beam, start, count, None if scan is None else scan[flat[start]])
 
 
-def segment_features(segments: Segments) -> np.ndarray:
+def segment_features(segments: Segments, shape: np.ndarray | None = None) -> np.ndarray:
     """The feature matrix ``(k, len(FEATURE_NAMES))`` of every segment, columns in
     :data:`FEATURE_NAMES` order (Arras, Mozos, Burgard 2007, §IV "Features"):
 
@@ -161,11 +250,74 @@ def segment_features(segments: Segments) -> np.ndarray:
 
     Segments of one return get zeros for the shape features; two returns give an undefined
     circle, reported as a zero residual and :data:`MAX_RADIUS`.
+
+    ``shape``: the indices (ascending) of the segments whose shape features (``std_centroid``,
+    ``mad_median``, the line and circle fits, the boundary and curvature) are computed; the
+    others get zeros there. The detector passes the segments it classifies: the shape features
+    cost per return, and the walls it does not classify hold most returns of a scan. The
+    features of a segment do not depend on which others are in ``shape``. None: every segment.
+
+    Segments of several scans (:func:`segment_scans`) get the features each has in its own
+    scan: no jump or context across scans. A tick brings several scans (a 40 Hz laser, a 10 Hz
+    tick), and most of the cost of this function is a fixed one per call.
     """
     k = len(segments.start)
     out = np.zeros((k, len(FEATURE_NAMES)))
     if k == 0:
         return out
+    xy, start, n = segments.xy, segments.start, segments.count
+    c = np.add.reduceat(xy, start, axis=0) / n[:, None]
+    out[:, 0] = n
+    last = start + n - 1
+    first_pt, last_pt = xy[start], xy[last]
+    jp = np.full(k, MAX_JUMP)
+    js = np.full(k, MAX_JUMP)
+    if k > 1:
+        gaps = np.hypot(*(first_pt[1:] - last_pt[:-1]).T)
+        if segments.scan is not None:  # no neighbour across the end of a scan
+            gaps[segments.scan[1:] != segments.scan[:-1]] = MAX_JUMP
+        jp[1:] = np.minimum(gaps, MAX_JUMP)
+        js[:-1] = np.minimum(gaps, MAX_JUMP)
+    out[:, 3], out[:, 4] = jp, js
+    out[:, 5] = np.hypot(*(last_pt - first_pt).T)
+    out[:, 13] = np.hypot(*c.T)
+    _context_features(out, c, n, segments.scan)
+    which = np.arange(k) if shape is None else np.asarray(shape, dtype=np.intp)
+    if len(which):
+        out[np.ix_(which, _SHAPE_COLUMNS)] = _shape_features(segments.subset(which))
+    return out
+
+
+#: The columns of :func:`_shape_features` in :data:`FEATURE_NAMES`.
+_SHAPE_COLUMNS = np.array([1, 2, 6, 7, 8, 9, 10, 11, 12])
+
+
+def _context_features(
+    out: np.ndarray, c: np.ndarray, n: np.ndarray, scan: np.ndarray | None
+) -> None:
+    """Fill ``partner_distance``, ``partner_width`` and ``neighbours`` of ``out`` (whose
+    ``width`` is filled) from the centroids ``c`` and return counts ``n`` (k × k, k is small),
+    among the segments of the same ``scan``."""
+    k = len(c)
+    gap = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1])
+    np.fill_diagonal(gap, np.inf)
+    if scan is not None:
+        gap[scan[:, None] != scan[None, :]] = np.inf
+    out[:, 16] = np.sum(gap <= NEIGHBOUR_RADIUS, axis=1)
+    legish = (n >= PARTNER_MIN_POINTS) & (out[:, 5] <= PARTNER_MAX_WIDTH)
+    gap[:, ~legish] = np.inf
+    nearest = np.argmin(gap, axis=1)
+    near = gap[np.arange(k), nearest]
+    found = near < MAX_JUMP
+    out[:, 14] = np.where(found, near, MAX_JUMP)
+    out[:, 15] = np.where(found, out[nearest, 5], 0.0)
+
+
+def _shape_features(segments: Segments) -> np.ndarray:
+    """The shape features ``(k, 9)`` of every segment, in :data:`_SHAPE_COLUMNS` order
+    (see :func:`segment_features`)."""
+    k = len(segments.start)
+    out = np.zeros((k, len(_SHAPE_COLUMNS)))
     xy, start, n = segments.xy, segments.start, segments.count
     nf = n.astype(float)
     seg_id = np.repeat(np.arange(k), n)
@@ -176,8 +328,7 @@ def segment_features(segments: Segments) -> np.ndarray:
     c = seg_sum(xy) / nf[:, None]
     d = xy - c[seg_id]
     sq = np.sum(d * d, axis=1)
-    out[:, 0] = nf
-    out[:, 1] = np.sqrt(seg_sum(sq) / np.maximum(nf - 1.0, 1.0))
+    out[:, 0] = np.sqrt(seg_sum(sq) / np.maximum(nf - 1.0, 1.0))
 
     # Coordinate-wise median: sort each coordinate within its segment.
     med = np.empty((k, 2))
@@ -187,18 +338,7 @@ def segment_features(segments: Segments) -> np.ndarray:
         order = np.lexsort((xy[:, j], seg_id))
         v = xy[order, j]
         med[:, j] = 0.5 * (v[lo] + v[hi])
-    out[:, 2] = seg_sum(np.hypot(*(xy - med[seg_id]).T)) / nf
-
-    last = start + n - 1
-    first_pt, last_pt = xy[start], xy[last]
-    jp = np.full(k, MAX_JUMP)
-    js = np.full(k, MAX_JUMP)
-    if k > 1:
-        gaps = np.hypot(*(first_pt[1:] - last_pt[:-1]).T)
-        jp[1:] = np.minimum(gaps, MAX_JUMP)
-        js[:-1] = np.minimum(gaps, MAX_JUMP)
-    out[:, 3], out[:, 4] = jp, js
-    out[:, 5] = np.hypot(*(last_pt - first_pt).T)
+    out[:, 1] = seg_sum(np.hypot(*(xy - med[seg_id]).T)) / nf
 
     # Line fit (total least squares) from the centred scatter matrix.
     sxx = seg_sum(d[:, 0] ** 2)
@@ -206,7 +346,7 @@ def segment_features(segments: Segments) -> np.ndarray:
     sxy = seg_sum(d[:, 0] * d[:, 1])
     half_tr = 0.5 * (sxx + syy)
     disc = np.sqrt(np.maximum(0.25 * (sxx - syy) ** 2 + sxy**2, 0.0))
-    out[:, 6] = np.maximum(half_tr - disc, 0.0)
+    out[:, 2] = np.maximum(half_tr - disc, 0.0)
 
     # Kåsa circle fit, centred: [[Suu Suv][Suv Svv]] [a b]ᵀ = ½ [Suuu+Suvv, Svvv+Svuu].
     u, v = d[:, 0], d[:, 1]
@@ -222,8 +362,8 @@ def segment_features(segments: Segments) -> np.ndarray:
     radius = np.sqrt(a * a + b * b + (sxx + syy) / nf)
     dist_c = np.hypot(u - a[seg_id], v - b[seg_id])
     resid = seg_sum((radius[seg_id] - dist_c) ** 2)
-    out[:, 7] = np.where(good, resid, out[:, 6])
-    out[:, 8] = np.where(good, np.minimum(radius, MAX_RADIUS), MAX_RADIUS)
+    out[:, 3] = np.where(good, resid, out[:, 2])
+    out[:, 4] = np.where(good, np.minimum(radius, MAX_RADIUS), MAX_RADIUS)
 
     # Boundary: steps between consecutive returns of the same segment.
     step = np.diff(xy, axis=0)
@@ -233,11 +373,11 @@ def segment_features(segments: Segments) -> np.ndarray:
     sl = step_len[inner]
     m_steps = np.bincount(sid, minlength=k).astype(float)
     blen = np.bincount(sid, weights=sl, minlength=k)
-    out[:, 9] = blen
+    out[:, 5] = blen
     with np.errstate(divide="ignore", invalid="ignore"):
         mean_step = np.where(m_steps > 0, blen / m_steps, 0.0)
         var = np.bincount(sid, weights=(sl - mean_step[sid]) ** 2, minlength=k)
-        out[:, 10] = np.where(m_steps > 0, np.sqrt(var / np.maximum(m_steps, 1.0)), 0.0)
+        out[:, 6] = np.where(m_steps > 0, np.sqrt(var / np.maximum(m_steps, 1.0)), 0.0)
 
     # Triples xᵢ₋₁ xᵢ xᵢ₊₁ within one segment: curvature and angular difference.
     if len(xy) >= 3:
@@ -254,21 +394,8 @@ def segment_features(segments: Segments) -> np.ndarray:
         ang = np.arctan2(cross, dot)
         m_trip = np.bincount(tid, minlength=k).astype(float)
         denom = np.maximum(m_trip, 1.0)
-        out[:, 11] = np.bincount(tid, weights=curv, minlength=k) / denom
-        out[:, 12] = np.bincount(tid, weights=ang, minlength=k) / denom
-    out[:, 13] = np.hypot(*c.T)
-
-    # Context: the nearest possible other leg and the clutter around (k × k, k is small).
-    gap = np.hypot(c[:, None, 0] - c[None, :, 0], c[:, None, 1] - c[None, :, 1])
-    np.fill_diagonal(gap, np.inf)
-    out[:, 16] = np.sum(gap <= NEIGHBOUR_RADIUS, axis=1)
-    legish = (n >= PARTNER_MIN_POINTS) & (out[:, 5] <= PARTNER_MAX_WIDTH)
-    gap[:, ~legish] = np.inf
-    nearest = np.argmin(gap, axis=1)
-    near = gap[np.arange(k), nearest]
-    found = near < MAX_JUMP
-    out[:, 14] = np.where(found, near, MAX_JUMP)
-    out[:, 15] = np.where(found, out[nearest, 5], 0.0)
+        out[:, 7] = np.bincount(tid, weights=curv, minlength=k) / denom
+        out[:, 8] = np.bincount(tid, weights=ang, minlength=k) / denom
     return out
 
 
@@ -282,5 +409,6 @@ __all__ = [
     "Segments",
     "segment_features",
     "segment_scan",
+    "segment_scans",
     "valid_returns",
 ]

@@ -33,6 +33,7 @@ from __future__ import annotations
 import json
 import zipfile
 from dataclasses import dataclass
+from functools import cached_property
 from io import BytesIO
 from typing import Any
 
@@ -42,6 +43,18 @@ FORMAT = "pfctl-leg-forest"
 FORMAT_VERSION = 1
 
 _ARRAYS = ("roots", "left", "right", "feature", "threshold", "leaf_probability")
+
+
+@dataclass(frozen=True)
+class _Walk:
+    """A forest's nodes for the vectorised descent: ``children[2 k]`` is node k's right child
+    and ``children[2 k + 1]`` its left one (index ``2 k + go_left``); a leaf is its own child."""
+
+    roots: np.ndarray
+    feature: np.ndarray
+    children: np.ndarray
+    is_leaf: np.ndarray
+    leaf_probability: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -106,21 +119,38 @@ class LegModel:
 
     def predict_proba(self, features: np.ndarray) -> np.ndarray:
         """P(leg) ``(n,)`` for feature rows ``(n, f)``: every sample descends every tree at once
-        (``depth`` vectorised steps), then the leaves' probabilities are averaged."""
-        x = np.asarray(features, dtype=np.float32)
+        (at most ``depth`` vectorised steps, fewer once every sample sits on a leaf), then the
+        leaves' probabilities are averaged."""
+        x = np.ascontiguousarray(features, dtype=np.float32)
         if x.ndim != 2 or x.shape[1] != len(self.feature_names):
             raise ValueError(
                 f"expected features of shape (n, {len(self.feature_names)}), got {x.shape}"
             )
-        n = len(x)
+        n, f = x.shape
         if n == 0:
             return np.empty(0)
-        node = np.broadcast_to(self.roots, (n, self.n_trees)).copy()
-        rows = np.arange(n)[:, None]
-        for _ in range(self.depth):
-            go_left = x[rows, self.feature[node]] <= self.threshold[node]
-            node = np.where(go_left, self.left[node], self.right[node])
-        return self.leaf_probability[node].astype(np.float64).mean(axis=1)
+        walk = self._walk
+        values = x.ravel()
+        row = (np.arange(n, dtype=np.intp) * f)[:, None]
+        node = np.broadcast_to(walk.roots, (n, self.n_trees)).copy()
+        for level in range(self.depth):
+            go_left = values.take(row + walk.feature.take(node)) <= self.threshold.take(node)
+            node = walk.children.take(2 * node + go_left)
+            if level % 4 == 3 and walk.is_leaf.take(node).all():
+                break
+        return walk.leaf_probability.take(node).mean(axis=1)
+
+    @cached_property
+    def _walk(self) -> _Walk:
+        """The node arrays as :meth:`predict_proba` walks them (built on first use)."""
+        nodes = np.arange(self.n_nodes)
+        return _Walk(
+            roots=self.roots.astype(np.intp),
+            feature=self.feature.astype(np.intp),
+            children=np.stack([self.right, self.left], axis=1).ravel().astype(np.intp),
+            is_leaf=self.left == nodes,
+            leaf_probability=self.leaf_probability.astype(np.float64),
+        )
 
     def to_bytes(self) -> bytes:
         """The model as ``.npz`` bytes (compressed)."""

@@ -9,16 +9,26 @@ import numpy as np
 import pytest
 from sklearn.ensemble import RandomForestClassifier
 
-from pfctl.core.perception.legs.detector import LegParams, pair_legs
+from pfctl.app.leg_models import load_leg_model
+from pfctl.core.perception.legs.detector import (
+    LegDetector,
+    LegParams,
+    classify_scans,
+    classify_segments,
+    describe_segments,
+    pair_legs,
+)
 from pfctl.core.perception.legs.features import (
     FEATURE_NAMES,
     MAX_JUMP,
     Segments,
     segment_features,
     segment_scan,
+    segment_scans,
 )
 from pfctl.core.perception.legs.model import LegModel
 from pfctl.core.perception.legs.training import LegDataset, label_by_positions, score, train_forest
+from pfctl.core.robot import LaserScan, Pose2D
 
 F = {name: i for i, name in enumerate(FEATURE_NAMES)}
 
@@ -163,3 +173,81 @@ def test_train_forest_gives_a_small_model_with_metadata() -> None:
     assert model.n_trees == 5 and model.depth <= 4
     assert model.metadata["seed"] == 3 and model.metadata["segments"] == 300
     assert ((model.predict_proba(x) >= 0.5) == (x[:, 1] > 0)).mean() > 0.9
+
+
+def _room_scan(seed: int, stamp: float = 0.0) -> LaserScan:
+    """A 270° scan at 0.25° (1 cm noise) of a room: walls 3–5 m off, a box with a 1.2–1.3 m
+    face, and three to six legs (6 cm radius) 0.8–3 m away, placed at random by ``seed``."""
+    rng = np.random.default_rng(seed)
+    angles = np.radians(np.arange(-135, 135.01, 0.25))
+    d = np.array([np.cos(angles), np.sin(angles)])
+    r = 4.0 + np.sin(2 * angles + rng.uniform(0, 6)) * 0.8
+    box = (angles > 0.3) & (angles < 0.3 + 1.2 / 2.0)  # a flat face 2 m away
+    r[box] = 2.0 / np.cos(angles[box] - 0.6)
+    for _ in range(int(rng.integers(3, 7))):
+        rho, phi = rng.uniform(0.8, 3.0), rng.uniform(-2.0, 2.0)
+        cx, cy = rho * math.cos(phi), rho * math.sin(phi)
+        b = -(d[0] * cx + d[1] * cy)
+        disc = b**2 - (cx**2 + cy**2 - 0.06**2)
+        hit = disc >= 0
+        r[hit] = np.minimum(r[hit], -b[hit] - np.sqrt(disc[hit]))
+    r = r + rng.normal(0, 0.01, len(r))
+    return LaserScan(
+        stamp, float(angles[0]), float(np.radians(0.25)), 0.05, 20.0, r, Pose2D(0.5, 0.2, 0.3)
+    )
+
+
+def test_shape_features_of_some_segments_are_theirs_among_all() -> None:
+    segs = segment_scan(_room_scan(0).ranges, -2.356, 0.00436, 0.05, 20.0, 0.13)
+    some = np.arange(0, len(segs), 3)
+    whole, part = segment_features(segs), segment_features(segs, shape=some)
+    np.testing.assert_array_equal(part[some], whole[some])
+    rest = np.setdiff1d(np.arange(len(segs)), some)
+    shape = [F[n] for n in ("std_centroid", "linearity", "radius", "mean_curvature")]
+    assert np.all(part[np.ix_(rest, shape)] == 0)
+    outline = [F[n] for n in ("points", "jump_preceding", "width", "distance", "neighbours")]
+    np.testing.assert_array_equal(part[:, outline], whole[:, outline])
+    # Several scans segmented and described in one pass: each as alone.
+    scans = [_room_scan(k, 0.025 * k) for k in range(3)]
+    joined = segment_scans(scans, 0.13)
+    feats = segment_features(joined)
+    parts = joined.split(len(scans))
+    assert [len(p[1]) for p in parts] == np.bincount(joined.scan).tolist()
+    for scan, (rows, segs) in zip(scans, parts, strict=True):
+        alone = segment_scan(
+            scan.ranges, scan.angle_min, scan.angle_increment, scan.range_min, 20.0, 0.13
+        )
+        for name in ("xy", "beam", "start", "count"):
+            np.testing.assert_array_equal(getattr(segs, name), getattr(alone, name))
+        np.testing.assert_array_equal(feats[rows], segment_features(alone))
+
+
+def test_a_ticks_scans_classified_in_one_pass_are_classified_as_each_alone() -> None:
+    model, params = load_leg_model(None), LegParams()
+    scans = [_room_scan(seed, 0.025 * seed) for seed in range(4)]
+    for alone, together in zip(
+        [classify_segments(s, model, params) for s in scans],
+        classify_scans(scans, model, params),
+        strict=True,
+    ):
+        np.testing.assert_array_equal(together.classified, alone.classified)
+        np.testing.assert_array_equal(together.features, alone.features)
+        np.testing.assert_allclose(together.probability, alone.probability, rtol=0, atol=1e-12)
+    # The detector given them finds what it finds alone, scan after scan (its history too).
+    one, batched = LegDetector(model, params), LegDetector(model, params)
+    legs = 0
+    for scan, c in zip(scans, batched.classify(scans), strict=True):
+        a, b = one.detect(scan), batched.detect(scan, classified=c)
+        assert b == a
+        legs += len(a.legs)
+    assert legs >= 8  # the scans hold 3-6 legs each, most of them found
+
+
+def test_segments_wider_than_max_width_are_not_classified() -> None:
+    scan = _room_scan(0)
+    segs, feats, ok = describe_segments(scan, LegParams())
+    box = int(np.argmin(np.abs(feats[:, F["width"]] - 1.2) + (segs.count < 20)))
+    assert 1.0 < feats[box, F["width"]] < 1.5
+    assert not ok[box] and feats[box, F["linearity"]] == 0.0  # no shape features computed
+    _, wide_feats, wide_ok = describe_segments(scan, LegParams(max_width=2.0))
+    assert wide_ok[box] and wide_feats[box, F["linearity"]] > 0.0
