@@ -57,7 +57,12 @@ class ClothesParams:
     @property
     def size(self) -> int:
         """Number of bins of a flattened histogram."""
-        return int(np.prod(self.bins))
+        return _size(tuple(self.bins))
+
+
+@functools.lru_cache(maxsize=8)
+def _size(bins: tuple[int, ...]) -> int:
+    return int(np.prod(bins))
 
 
 def convert(rgb: np.ndarray, space: ColorSpace) -> np.ndarray:
@@ -98,15 +103,15 @@ def color_histogram(
     pixels = img[mask.astype(bool)]
     pairs, third = _soft_bins(params.color_space, tuple(int(b) for b in params.bins))
     first_two = pixels[:, 0].astype(np.intp) * 256 + pixels[:, 1]
-    last = pixels[:, 2]
+    last = pixels[:, 2].astype(np.intp)
     corners = [(k[last], f[last]) for k, f in third]
-    stride = params.bins[2]
-    hist = np.zeros(params.size)
+    size = params.size
+    hist = np.zeros(size)
     for pair_index, pair_weight in pairs:  # the 8 corners of each pixel's trilinear cell
-        index = pair_index[first_two] * stride
+        index = pair_index[first_two]
         weight = pair_weight[first_two]
         for k, f in corners:
-            hist += np.bincount(index + k, weights=weight * f, minlength=params.size)
+            hist += np.bincount(index + k, weights=weight * f, minlength=size)
     total = float(hist.sum())
     return hist / total if total > 0 else None
 
@@ -116,12 +121,13 @@ def _soft_bins(
     space: str, bins: tuple[int, ...]
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
     """Lookup tables of :func:`color_histogram` over the 8-bit channel values: for channels 0
-    and 1 together (index ``v0 · 256 + v1``), the flat bin ``k0 · bins[1] + k1`` and weight
-    ``f0 · f1`` of each of their four pairs of neighbouring bins; for channel 2, its two bins
-    and weights. Each entry is computed with the same floating-point operations, in the same
-    order, as from the pixel itself, so the histogram is the same, bit for bit, as computing
-    every pixel's bins and weights, in less time (a person near the camera has tens of thousands
-    of pixels, each looked up instead of computed)."""
+    and 1 together (index ``v0 · 256 + v1``), the flat bin ``k0 · bins[1] + k1`` times
+    ``bins[2]`` (the flat bin of its channel-2 bin 0) and weight ``f0 · f1`` of each of their
+    four pairs of neighbouring bins; for channel 2, its two bins and weights. Each entry is
+    computed with the same floating-point operations, in the same order, as from the pixel
+    itself, so the histogram is the same, bit for bit, as computing every pixel's bins and
+    weights, in less time (a person near the camera has tens of thousands of pixels, each
+    looked up instead of computed)."""
     ranges = _RANGES[space]
     values = np.arange(256, dtype=np.float64)
     channels: list[list[tuple[np.ndarray, np.ndarray]]] = []
@@ -138,7 +144,10 @@ def _soft_bins(
             k0, k1 = np.clip(k0, 0, n - 1), np.clip(k1, 0, n - 1)
         channels.append([(k0, 1.0 - frac), (k1, frac)])
     pairs = [
-        ((ka[:, None] * bins[1] + kb[None, :]).ravel(), (fa[:, None] * fb[None, :]).ravel())
+        (
+            (ka[:, None] * bins[1] + kb[None, :]).ravel() * bins[2],
+            (fa[:, None] * fb[None, :]).ravel(),
+        )
         for ka, fa in channels[0]
         for kb, fb in channels[1]
     ]
