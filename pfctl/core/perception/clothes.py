@@ -21,6 +21,7 @@ line (either colour) out of both.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -95,25 +96,55 @@ def color_histogram(
     (:func:`_soft_bins`), the same numbers as computed from the pixel; ValueError for an image
     that is not 8-bit.
     """
-    if not np.any(mask):
-        return None
+    return color_histograms(image, (mask,), params, converted)[0]
+
+
+def color_histograms(
+    image: np.ndarray,
+    masks: Sequence[np.ndarray],
+    params: ClothesParams,
+    converted: bool = False,
+) -> list[np.ndarray | None]:
+    """:func:`color_histogram` of each of ``masks`` over the same ``image`` (a person's upper
+    and lower body), the same arrays, bit for bit, in one pass: the masks' pixels one after
+    the other, each mask's bins offset by the histogram size, so that every bin still sums its
+    own pixels' weights in their row-major order, one ``bincount`` per corner for all."""
+    sel = [np.asarray(mask).astype(bool, copy=False) for mask in masks]
+    counts = [int(np.count_nonzero(mask)) for mask in sel]
+    if not any(counts):
+        return [None] * len(sel)
     img = image if converted else convert(image, params.color_space)
     if img.dtype != np.uint8:
         raise ValueError(f"color_histogram needs an 8-bit image, got {img.dtype}")
-    pixels = img[mask.astype(bool)]
+    # the selected pixels' channels one at a time (faster than selecting (n, 3) pixels)
+    channels = []
+    for c in range(3):
+        plane = img[..., c]
+        picked = [plane[mask] for mask, n in zip(sel, counts, strict=True) if n]
+        channels.append(picked[0] if len(picked) == 1 else np.concatenate(picked))
     pairs, third = _soft_bins(params.color_space, tuple(int(b) for b in params.bins))
-    first_two = pixels[:, 0].astype(np.intp) * 256 + pixels[:, 1]
-    last = pixels[:, 2].astype(np.intp)
+    first_two = channels[0].astype(np.intp) * 256 + channels[1]
+    last = channels[2].astype(np.intp)
     corners = [(k[last], f[last]) for k, f in third]
     size = params.size
-    hist = np.zeros(size)
+    shown = [i for i, n in enumerate(counts) if n]
+    offset = None
+    if len(shown) > 1:
+        offset = np.repeat(np.arange(len(shown)) * size, [counts[i] for i in shown])
+    hist = np.zeros(size * len(shown))
     for pair_index, pair_weight in pairs:  # the 8 corners of each pixel's trilinear cell
         index = pair_index[first_two]
+        if offset is not None:
+            index += offset
         weight = pair_weight[first_two]
         for k, f in corners:
-            hist += np.bincount(index + k, weights=weight * f, minlength=size)
-    total = float(hist.sum())
-    return hist / total if total > 0 else None
+            hist += np.bincount(index + k, weights=weight * f, minlength=len(hist))
+    out: list[np.ndarray | None] = [None] * len(sel)
+    for j, i in enumerate(shown):
+        h = hist[j * size : (j + 1) * size].copy()
+        total = float(h.sum())
+        out[i] = h / total if total > 0 else None
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -263,6 +294,7 @@ __all__ = [
     "body_parts",
     "body_parts_window",
     "color_histogram",
+    "color_histograms",
     "convert",
     "histogram_intersection",
 ]
