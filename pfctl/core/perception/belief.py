@@ -25,10 +25,12 @@ the far range, samples at half-cell steps), finds where each ray first meets a b
 marks a cell visible when it lies in the wedge, between ``range_min`` and ``range_max`` (horizontal
 distance from the camera, depth-limited), and nearer than the first blocked cell along its
 nearest ray. Everything is vectorised and confined to the wedge's bounding box, cut to the
-longest free ray (nothing beyond it can be seen). The rays are cast a metre at a time and a ray
-that has met a blocked cell is not cast further (most end at a wall a few metres away); the
-grid's border counts as blocked through a padded copy of ``blocked`` made once per belief. The
-cells are exactly those of casting every ray to the far range over the whole box (tested).
+longest free ray (nothing beyond it can be seen) and to the box of the rays' free ends; the
+arctangent of the bearing is taken only for the cells in range and inside a slightly wider
+wedge. The rays are cast two metres at a time and a ray that has met a blocked cell is not cast
+further (most end at a wall a few metres away); the grid's border counts as blocked through a
+padded copy of ``blocked`` made once per belief. The cells are exactly those of casting every
+ray to the far range over the whole box (tested).
 
 **Peaks.** :meth:`HumanBelief.most_likely` (the gaze's candidates) ranks cells by belief, then
 by cell index, and picks greedily those at least ``min_separation`` apart. The best cells are
@@ -150,8 +152,10 @@ def _window(
 #: this angle, radians (a product test, no arctangent; far wider than its round-off).
 _WEDGE_MARGIN = 0.01
 
-#: Samples per ray cast at once (1 m at 0.05 m cells); rays that hit stop there.
-_RAY_CHUNK = 40
+#: Samples per ray cast at once (2 m at 0.05 m cells); rays that hit stop there. Fewer,
+#: larger chunks cost less than casting a few samples too many (crowd benchmark: 80 against
+#: 40 took ~18 % off the ray casting).
+_RAY_CHUNK = 80
 
 
 def _padded(blocked: NDArray[np.bool_]) -> NDArray[np.bool_]:
