@@ -405,17 +405,25 @@ class Follower:
         the legs, else the navigation goal) on what the perception knows, leaving out the
         people Algorithm 2 has already identified as not the target."""
         perception = self.perception
-        known = perception.not_target(target.track_id if target is not None else None)
+        if target is not None:  # the rule's first choice (choose_gaze): nothing else matters
+            return LookAt((float(target.xy[0]), float(target.xy[1])), "target")
+        known = perception.not_target(None)
         belief = perception.belief
+        # only the peaks at least belief_threshold likely can draw the gaze: the others are
+        # left out here rather than in gaze_rule (the same peaks, found faster)
         peaks = (
-            belief.most_likely(PEAK_CANDIDATES, min_separation=KNOWN_RADIUS)
+            belief.most_likely(
+                PEAK_CANDIDATES,
+                min_separation=KNOWN_RADIUS,
+                at_least=self.params.belief_threshold,
+            )
             if belief is not None
             else []
         )
         legs = perception.last_legs
         point, source = gaze_rule(
             (pose.x, pose.y),
-            target.xy if target is not None else None,
+            None,
             peaks,
             [(c.x, c.y) for c in legs.people] if legs is not None else [],
             known_xy=known,

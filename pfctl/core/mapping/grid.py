@@ -179,16 +179,17 @@ def _crossings(
     (the caller marks the one before it too).
 
     All beams' crossings go in one flat array, with no padding to the longest beam. In-place
-    int32 arithmetic; truncation is floor() here since all points are ≥ 0.
+    int32 arithmetic; truncation is floor() here since all points are ≥ 0. Each beam's values
+    are repeated over its crossings (``numpy.repeat``, a sequential copy) rather than gathered
+    through a per-crossing beam index: the same numbers.
     """
-    beam = np.repeat(np.arange(len(counts)), counts)
-    k = np.arange(len(beam), dtype=np.int32)
-    k -= (np.cumsum(counts) - counts).astype(np.int32)[beam]
-    minor_f = k * slope[beam]
-    minor_f += minor0[beam]
+    k = np.arange(int(counts.sum()), dtype=np.int32)
+    k -= np.repeat((np.cumsum(counts) - counts).astype(np.int32), counts)
+    minor_f = k * np.repeat(slope, counts)
+    minor_f += np.repeat(minor0, counts)
     minor = minor_f.astype(np.int32)
     line = k
-    line += first.astype(np.int32)[beam]
+    line += np.repeat(first.astype(np.int32), counts)
     if along_x:  # line = column i, minor = row: cells (row, i) and (row, i − 1)
         minor *= width
         minor += line
@@ -509,14 +510,12 @@ class OccupancyGrid:
             m = m[keep]
             minor0 = ns[major][keep] + (first - a[keep]) * m  # the minor coordinate there
             minor = _crossings(first, m, minor0, n[keep], W, along_x)
-            crossed = np.zeros(H * W, dtype=bool)
-            crossed[minor] = True
-            c2 = crossed.reshape(H, W)
-            free2 |= c2
-            if along_x:
-                free2[:, :-1] |= c2[:, 1:]
-            else:
-                free2[:-1, :] |= c2[1:, :]
+            # The cell past each crossed line and the one before it, marked in place: the
+            # lines crossed are 1 … W − 1 (rows: 1 … H − 1) since the segments stay _EDGE
+            # inside the grid, so the cell before is always in the same row (column).
+            free[minor] = True
+            minor -= 1 if along_x else W
+            free[minor] = True
         return hit.reshape(H, W), free2
 
     # -------------------------------------------------------------------------------- nav_msgs

@@ -25,10 +25,12 @@ the far range, samples at half-cell steps), finds where each ray first meets a b
 marks a cell visible when it lies in the wedge, between ``range_min`` and ``range_max`` (horizontal
 distance from the camera, depth-limited), and nearer than the first blocked cell along its
 nearest ray. Everything is vectorised and confined to the wedge's bounding box, cut to the
-longest free ray (nothing beyond it can be seen). The rays are cast a metre at a time and a ray
-that has met a blocked cell is not cast further (most end at a wall a few metres away); the
-grid's border counts as blocked through a padded copy of ``blocked`` made once per belief. The
-cells are exactly those of casting every ray to the far range over the whole box (tested).
+longest free ray (nothing beyond it can be seen) and to the box of the rays' free ends; the
+arctangent of the bearing is taken only for the cells in range and inside a slightly wider
+wedge. The rays are cast two metres at a time and a ray that has met a blocked cell is not cast
+further (most end at a wall a few metres away); the grid's border counts as blocked through a
+padded copy of ``blocked`` made once per belief. The cells are exactly those of casting every
+ray to the far range over the whole box (tested).
 
 **Peaks.** :meth:`HumanBelief.most_likely` (the gaze's candidates) ranks cells by belief, then
 by cell index, and picks greedily those at least ``min_separation`` apart. The best cells are
@@ -146,8 +148,14 @@ def _window(
     return r0, r1, c0, c1, far
 
 
-#: Samples per ray cast at once (1 m at 0.05 m cells); rays that hit stop there.
-_RAY_CHUNK = 40
+#: The visible cells' bearings are computed only for the cells within the wedge widened by
+#: this angle, radians (a product test, no arctangent; far wider than its round-off).
+_WEDGE_MARGIN = 0.01
+
+#: Samples per ray cast at once (2 m at 0.05 m cells); rays that hit stop there. Fewer,
+#: larger chunks cost less than casting a few samples too many (crowd benchmark: 80 against
+#: 40 took ~18 % off the ray casting).
+_RAY_CHUNK = 80
 
 
 def _padded(blocked: NDArray[np.bool_]) -> NDArray[np.bool_]:
@@ -182,13 +190,25 @@ def _first_blocked(
     cos_a, sin_a = np.cos(angles), np.sin(angles)
     for start in range(0, len(s), _RAY_CHUNK):
         chunk = s[None, start : start + _RAY_CHUNK]
-        px = x0 + cos_a[active][:, None] * chunk
-        py = y0 + sin_a[active][:, None] * chunk
-        cols = np.floor((px - ox) / res)
-        rows = np.floor((py - oy) / res)
-        np.clip(cols, -1, w, out=cols)
-        np.clip(rows, -1, h, out=rows)
-        cells = (rows.astype(np.intp) + 1) * (w + 2) + cols.astype(np.intp) + 1
+        # cell column and row of x0 + cos·s and y0 + sin·s, in place: the same arithmetic
+        # as floor((x0 + cos·s − ox) / res), clipped to [−1, w] (and rows to [−1, h])
+        cells = np.zeros((len(active), chunk.shape[1]), dtype=np.intp)
+        for trig, start_xy, origin, size, scale in (
+            (sin_a, y0, oy, h, w + 2),
+            (cos_a, x0, ox, w, 1),
+        ):
+            q = trig[active][:, None] * chunk
+            q += start_xy
+            q -= origin
+            q /= res
+            np.floor(q, out=q)
+            np.maximum(q, -1, out=q)
+            np.minimum(q, size, out=q)
+            index = q.astype(np.intp)
+            index += 1
+            if scale != 1:
+                index *= scale
+            cells += index
         hit = padded[cells]
         ended = hit.any(axis=1)
         first[active[ended]] = start + hit[ended].argmax(axis=1)
@@ -196,6 +216,35 @@ def _first_blocked(
         if not len(active):
             break
     return first
+
+
+def _hull_window(
+    geometry: GridGeometry,
+    fov: FieldOfView,
+    window: tuple[int, int, int, int, float],
+    angles: NDArray[np.float64],
+    ends: NDArray[np.float64],
+    ray_step: float,
+) -> tuple[int, int, int, int, float]:
+    """``window`` cut to the bounding box of the camera and the rays' free ends (``ends``
+    along ``angles``), widened by half a ray step at the longest end and two cells: a visible
+    cell is nearer than the free end of its nearest ray (at most half a ray step off it), so
+    its centre lies in that box, and the cells cut away are not visible (fewer cells for the
+    tests of :func:`_visible_window`, the same visible ones)."""
+    r0, r1, c0, c1, far = window
+    x0, y0 = fov.origin.x, fov.origin.y
+    xs = x0 + ends * np.cos(angles)
+    ys = y0 + ends * np.sin(angles)
+    pad = float(ends.max(initial=0.0)) * ray_step / 2 + 2 * geometry.resolution
+    ox, oy = geometry.origin
+    res = geometry.resolution
+    c0 = max(c0, math.floor((min(float(xs.min()), x0) - pad - ox) / res))
+    c1 = min(c1, math.floor((max(float(xs.max()), x0) + pad - ox) / res) + 1)
+    r0 = max(r0, math.floor((min(float(ys.min()), y0) - pad - oy) / res))
+    r1 = min(r1, math.floor((max(float(ys.max()), y0) + pad - oy) / res) + 1)
+    if r0 >= r1 or c0 >= c1:  # nothing visible: an empty box at the window's corner
+        return window[0], window[0], window[2], window[2], far
+    return r0, r1, c0, c1, far
 
 
 def _visible_window(
@@ -232,20 +281,34 @@ def _visible_window(
             window = _window(geometry, fov, reach)
             if window is None:
                 return None
+        window = _hull_window(geometry, fov, window, ray_angles, np.minimum(free, far), ray_step)
     r0, r1, c0, c1, _ = window
     x = geometry.origin[0] + (np.arange(c0, c1) + 0.5) * res - fov.origin.x
     y = geometry.origin[1] + (np.arange(r0, r1) + 0.5) * res - fov.origin.y
     dx, dy = x[None, :], y[:, None]
     dist = np.hypot(dx, dy)
-    bearing = np.arctan2(dy, dx) - fov.origin.theta
+    mask = (dist >= fov.range_min) & (dist <= fov.range_max)
+    if blocked is not None:
+        mask &= ~blocked[r0:r1, c0:c1]
+    if half + _WEDGE_MARGIN < math.pi:
+        # Only cells within the wedge widened by _WEDGE_MARGIN can pass the bearing test
+        # below: a product test (no arctangent) leaves out the others first.
+        cos_t, sin_t = math.cos(fov.origin.theta), math.sin(fov.origin.theta)
+        ahead = dx * cos_t + dy * sin_t
+        mask &= ahead >= dist * math.cos(half + _WEDGE_MARGIN)
+    # The bearing, the wedge and the occlusion tests on the cells still in: the same
+    # arithmetic, cell by cell, as over the whole box.
+    cells = np.flatnonzero(mask)
+    rows, cols = np.divmod(cells, c1 - c0)
+    cdx, cdy, cdist = x[cols], y[rows], dist.ravel()[cells]
+    bearing = np.arctan2(cdy, cdx) - fov.origin.theta
     bearing = (bearing + np.pi) % (2.0 * np.pi) - np.pi
-    mask = (dist >= fov.range_min) & (dist <= fov.range_max) & (np.abs(bearing) <= half)
-    if blocked is None:
-        return (r0, r1, c0, c1), mask
-    ray = np.rint((bearing + half) / ray_step).astype(np.intp)
-    np.clip(ray, 0, n_rays - 1, out=ray)
-    mask &= dist < free[ray]
-    mask &= ~blocked[r0:r1, c0:c1]
+    keep = np.abs(bearing) <= half
+    if blocked is not None:
+        ray = np.rint((bearing + half) / ray_step).astype(np.intp)
+        np.clip(ray, 0, n_rays - 1, out=ray)
+        keep &= cdist < free[ray]
+    mask.ravel()[cells] = keep
     return (r0, r1, c0, c1), mask
 
 
@@ -437,7 +500,9 @@ class HumanBelief:
         x, y = self.geometry.cell_to_world(row, col)
         return float(x), float(y)
 
-    def most_likely(self, k: int, min_separation: float = 0.0) -> list[tuple[float, float, float]]:
+    def most_likely(
+        self, k: int, min_separation: float = 0.0, *, at_least: float = 0.0
+    ) -> list[tuple[float, float, float]]:
         """Up to ``k`` cells ``(x, y, p)`` by decreasing belief, at least ``min_separation`` m
         apart (greedy: a cell closer than that to an already chosen one is skipped).
 
@@ -446,12 +511,25 @@ class HumanBelief:
         beliefs are taken top-left first; cells at 0 are never returned. The selection
         (:func:`_top_cells`) costs a count over the grid, not a sort; the greedy picks are
         vectorised (one distance pass per pick).
+
+        ``at_least`` > 0 returns only the cells of belief ≥ ``at_least``: the leading cells of
+        the list without it (the picks come by decreasing belief and a pick depends only on
+        the picks before it), and when no more than the candidates are that likely (a belief
+        grid holds few: the people), the candidates are those cells alone, found by one
+        comparison over the grid instead of the count of :func:`_top_cells` (the gaze rule's
+        peaks, :func:`~pfctl.core.control.gaze_rule`, ask for those above its threshold).
         """
         if k <= 0:
             return []
         flat = self.p.ravel()
-        pool = k if min_separation <= 0 else max(64 * k, 1024)
-        idx = _top_cells(flat, min(pool, flat.size))
+        pool = min(k if min_separation <= 0 else max(64 * k, 1024), flat.size)
+        idx = np.flatnonzero(flat >= at_least) if at_least > 0.0 else None
+        if idx is not None and idx.size <= pool:
+            # all of them are among the ``pool`` best, in the same order (belief, then index)
+            idx = idx[np.lexsort((idx, -flat[idx]))]
+        else:
+            idx = _top_cells(flat, pool)
+            idx = idx[flat[idx] >= at_least] if at_least > 0.0 else idx
         idx = idx[flat[idx] > 0.0]
         rows, cols = np.unravel_index(idx, self.p.shape)
         centres = self.geometry.cell_to_world(rows, cols)

@@ -21,6 +21,7 @@ line (either colour) out of both.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal
 
@@ -57,7 +58,12 @@ class ClothesParams:
     @property
     def size(self) -> int:
         """Number of bins of a flattened histogram."""
-        return int(np.prod(self.bins))
+        return _size(tuple(self.bins))
+
+
+@functools.lru_cache(maxsize=8)
+def _size(bins: tuple[int, ...]) -> int:
+    return int(np.prod(bins))
 
 
 def convert(rgb: np.ndarray, space: ColorSpace) -> np.ndarray:
@@ -90,25 +96,55 @@ def color_histogram(
     (:func:`_soft_bins`), the same numbers as computed from the pixel; ValueError for an image
     that is not 8-bit.
     """
-    if not np.any(mask):
-        return None
+    return color_histograms(image, (mask,), params, converted)[0]
+
+
+def color_histograms(
+    image: np.ndarray,
+    masks: Sequence[np.ndarray],
+    params: ClothesParams,
+    converted: bool = False,
+) -> list[np.ndarray | None]:
+    """:func:`color_histogram` of each of ``masks`` over the same ``image`` (a person's upper
+    and lower body), the same arrays, bit for bit, in one pass: the masks' pixels one after
+    the other, each mask's bins offset by the histogram size, so that every bin still sums its
+    own pixels' weights in their row-major order, one ``bincount`` per corner for all."""
+    sel = [np.asarray(mask).astype(bool, copy=False) for mask in masks]
+    counts = [int(np.count_nonzero(mask)) for mask in sel]
+    if not any(counts):
+        return [None] * len(sel)
     img = image if converted else convert(image, params.color_space)
     if img.dtype != np.uint8:
         raise ValueError(f"color_histogram needs an 8-bit image, got {img.dtype}")
-    pixels = img[mask.astype(bool)]
+    # the selected pixels' channels one at a time (faster than selecting (n, 3) pixels)
+    channels = []
+    for c in range(3):
+        plane = img[..., c]
+        picked = [plane[mask] for mask, n in zip(sel, counts, strict=True) if n]
+        channels.append(picked[0] if len(picked) == 1 else np.concatenate(picked))
     pairs, third = _soft_bins(params.color_space, tuple(int(b) for b in params.bins))
-    first_two = pixels[:, 0].astype(np.intp) * 256 + pixels[:, 1]
-    last = pixels[:, 2]
+    first_two = channels[0].astype(np.intp) * 256 + channels[1]
+    last = channels[2].astype(np.intp)
     corners = [(k[last], f[last]) for k, f in third]
-    stride = params.bins[2]
-    hist = np.zeros(params.size)
+    size = params.size
+    shown = [i for i, n in enumerate(counts) if n]
+    offset = None
+    if len(shown) > 1:
+        offset = np.repeat(np.arange(len(shown)) * size, [counts[i] for i in shown])
+    hist = np.zeros(size * len(shown))
     for pair_index, pair_weight in pairs:  # the 8 corners of each pixel's trilinear cell
-        index = pair_index[first_two] * stride
+        index = pair_index[first_two]
+        if offset is not None:
+            index += offset
         weight = pair_weight[first_two]
         for k, f in corners:
-            hist += np.bincount(index + k, weights=weight * f, minlength=params.size)
-    total = float(hist.sum())
-    return hist / total if total > 0 else None
+            hist += np.bincount(index + k, weights=weight * f, minlength=len(hist))
+    out: list[np.ndarray | None] = [None] * len(sel)
+    for j, i in enumerate(shown):
+        h = hist[j * size : (j + 1) * size].copy()
+        total = float(h.sum())
+        out[i] = h / total if total > 0 else None
+    return out
 
 
 @functools.lru_cache(maxsize=8)
@@ -116,12 +152,13 @@ def _soft_bins(
     space: str, bins: tuple[int, ...]
 ) -> tuple[list[tuple[np.ndarray, np.ndarray]], list[tuple[np.ndarray, np.ndarray]]]:
     """Lookup tables of :func:`color_histogram` over the 8-bit channel values: for channels 0
-    and 1 together (index ``v0 · 256 + v1``), the flat bin ``k0 · bins[1] + k1`` and weight
-    ``f0 · f1`` of each of their four pairs of neighbouring bins; for channel 2, its two bins
-    and weights. Each entry is computed with the same floating-point operations, in the same
-    order, as from the pixel itself, so the histogram is the same, bit for bit, as computing
-    every pixel's bins and weights, in less time (a person near the camera has tens of thousands
-    of pixels, each looked up instead of computed)."""
+    and 1 together (index ``v0 · 256 + v1``), the flat bin ``k0 · bins[1] + k1`` times
+    ``bins[2]`` (the flat bin of its channel-2 bin 0) and weight ``f0 · f1`` of each of their
+    four pairs of neighbouring bins; for channel 2, its two bins and weights. Each entry is
+    computed with the same floating-point operations, in the same order, as from the pixel
+    itself, so the histogram is the same, bit for bit, as computing every pixel's bins and
+    weights, in less time (a person near the camera has tens of thousands of pixels, each
+    looked up instead of computed)."""
     ranges = _RANGES[space]
     values = np.arange(256, dtype=np.float64)
     channels: list[list[tuple[np.ndarray, np.ndarray]]] = []
@@ -138,7 +175,10 @@ def _soft_bins(
             k0, k1 = np.clip(k0, 0, n - 1), np.clip(k1, 0, n - 1)
         channels.append([(k0, 1.0 - frac), (k1, frac)])
     pairs = [
-        ((ka[:, None] * bins[1] + kb[None, :]).ravel(), (fa[:, None] * fb[None, :]).ravel())
+        (
+            (ka[:, None] * bins[1] + kb[None, :]).ravel() * bins[2],
+            (fa[:, None] * fb[None, :]).ravel(),
+        )
         for ka, fa in channels[0]
         for kb, fb in channels[1]
     ]
@@ -254,6 +294,7 @@ __all__ = [
     "body_parts",
     "body_parts_window",
     "color_histogram",
+    "color_histograms",
     "convert",
     "histogram_intersection",
 ]

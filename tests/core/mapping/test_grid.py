@@ -344,3 +344,58 @@ def test_crossings_without_padding_equal_the_padded_matrix() -> None:
             want = minor * width + line if along_x else line * width + minor
             assert len(got) == counts.sum()
             assert set(got.tolist()) == set(want.ravel().tolist()), trial
+
+
+def test_crossed_lines_lie_inside_so_the_cell_before_is_in_the_same_row() -> None:
+    """scan_masks marks the cell before each crossed grid line by index − 1 (x-major beams) or
+    index − width (y-major), in place of the full-grid shifted masks it used: the same cells as
+    long as no crossing lies in column 0 (row 0), which the _EDGE clipping guarantees. Checked
+    on random scans from inside, on the border of and outside the grid, beams along the axes
+    included, and the masks are those of the shifted-mask formulation."""
+    import pfctl.core.mapping.grid as grid_module
+
+    rng = np.random.default_rng(12)
+    seen: list[tuple[np.ndarray, bool]] = []
+    original = grid_module._crossings
+
+    def recording(first, slope, minor0, counts, width, along_x):  # type: ignore[no-untyped-def]
+        out = original(first, slope, minor0, counts, width, along_x)
+        seen.append((out.copy(), along_x))
+        return out
+
+    grid_module._crossings = recording  # type: ignore[assignment]
+    try:
+        for trial in range(60):
+            w, h = int(rng.integers(1, 80)), int(rng.integers(1, 80))
+            grid = OccupancyGrid(GridGeometry(resolution=0.05, width=w, height=h))
+            x, y = rng.uniform(-1.0, w * 0.05 + 1.0), rng.uniform(-1.0, h * 0.05 + 1.0)
+            if trial % 4 == 0:  # on a cell border
+                x, y = round(x / 0.05) * 0.05, round(y / 0.05) * 0.05
+            n = int(rng.integers(1, 400))
+            ranges = rng.uniform(0.0, 6.0, n)
+            ranges[rng.random(n) < 0.1] = np.inf
+            increment = [2 * math.pi / n, math.pi / 2, 0.01][trial % 3]
+            seen.clear()
+            _, free = grid.scan_masks((x, y, rng.uniform(-4, 4)), ranges, 0.0, increment, 5.0)
+            crossed = np.zeros(w * h, dtype=bool)
+            shifted = np.zeros((h, w), dtype=bool)
+            for cells, along_x in seen:
+                if along_x:
+                    assert np.all(cells % w >= 1), trial
+                else:
+                    assert np.all(cells // w >= 1), trial
+                c = np.zeros(w * h, dtype=bool)
+                c[cells] = True
+                c2 = c.reshape(h, w)
+                crossed |= c
+                if along_x:
+                    shifted[:, :-1] |= c2[:, 1:]
+                else:
+                    shifted[:-1, :] |= c2[1:, :]
+            # every crossed cell and its shifted neighbour is free, and nothing else but the
+            # segments' end cells is
+            marked = crossed.reshape(h, w) | shifted
+            assert np.all(free[marked]), trial
+            assert np.count_nonzero(free & ~marked) <= 2 * n, trial
+    finally:
+        grid_module._crossings = original  # type: ignore[assignment]

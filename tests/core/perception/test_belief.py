@@ -283,3 +283,29 @@ def test_most_likely_equals_the_plain_greedy_with_ties() -> None:
         belief.p[int(rows) - 3 : int(rows) + 4, int(cols) - 3 : int(cols) + 4] = 0.6
     for k, separation in ((8, 1.0), (3, 0.0), (20, 0.3)):
         assert belief.most_likely(k, separation) == _reference_most_likely(belief, k, separation)
+
+
+def test_most_likely_at_least_gives_the_leading_peaks_of_the_plain_greedy() -> None:
+    """``at_least`` (the gaze rule's threshold) returns exactly the peaks of the plain list at
+    least that likely: few likely cells (found by one comparison), more than the candidates
+    (the counting path), ties at the threshold, none at all."""
+    rng = np.random.default_rng(21)
+    for trial in range(120):
+        shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
+        geometry = GridGeometry(0.05, shape[1], shape[0], (0.0, 0.0))
+        kind = trial % 3
+        if kind == 0:
+            p = rng.choice([0.0, 0.001, 0.05, 0.3, 0.999], size=shape)
+        elif kind == 1:
+            p = rng.random(shape)
+        else:
+            p = np.where(rng.random(shape) < 0.02, rng.choice([0.3, 0.6, 0.9], shape), 0.05)
+        belief = HumanBelief(geometry, BeliefParams())
+        belief.p = p
+        for k in (1, 3, 8, 40):
+            for separation in (0.0, 0.12, 1.0):
+                plain = _reference_most_likely(belief, k, separation)
+                for at_least in (0.3, 0.5, 0.95, 1.0):
+                    want = [peak for peak in plain if peak[2] >= at_least]
+                    got = belief.most_likely(k, separation, at_least=at_least)
+                    assert got == want, (trial, k, separation, at_least)

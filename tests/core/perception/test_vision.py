@@ -234,3 +234,41 @@ def test_mask_detector_equals_the_plain_per_person_passes() -> None:
             assert got == _reference_detect(det, frame), trial
             found += len(got)
     assert found > 100
+
+
+def _plain_pixels_to_map(frame: RgbdFrame, us: np.ndarray, vs: np.ndarray) -> np.ndarray:
+    """:func:`pixels_to_map` as first written (stacked columns, broadcast translation)."""
+    z = frame.depth[vs, us].astype(float)
+    ok = np.isfinite(z) & (z > 0)
+    info = frame.info
+    z, u, v = z[ok], us[ok].astype(float), vs[ok].astype(float)
+    cam = np.column_stack(((u - info.cx) * z / info.fx, (v - info.cy) * z / info.fy, z))
+    return cam @ np.asarray(frame.camera_rotation, dtype=float).T + np.asarray(
+        frame.camera_position, dtype=float
+    )
+
+
+def test_back_projection_and_medians_equal_the_plain_formulas_bit_for_bit() -> None:
+    """The in-place back-projection, the per-column medians of the body position and the
+    counted median of the torso's and legs' columns give the numbers of the plain formulas
+    (column_stack, ``numpy.median`` over axis 0 and of the columns), on random camera poses,
+    depths with holes and pixel sets of odd and even sizes."""
+    from pfctl.core.perception.vision import _int_median
+
+    rng = np.random.default_rng(17)
+    for trial in range(60):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        depth = rng.uniform(0.3, 9.0, (H, W))
+        depth[rng.random((H, W)) < 0.05] = [np.inf, 0.0, np.nan][trial % 3]
+        frame = replace(
+            _frame(depth), camera_rotation=q, camera_position=tuple(rng.uniform(-5, 5, 3))
+        )
+        n = int(rng.integers(1, 4000))
+        us, vs = rng.integers(0, W, n), rng.integers(0, H, n)
+        pts = pixels_to_map(frame, us, vs)
+        want = _plain_pixels_to_map(frame, us, vs)
+        assert pts.shape == want.shape and np.array_equal(pts, want), trial
+        got = body_position(frame, us, vs, 0.0)
+        assert got == tuple(float(v) for v in np.median(want, axis=0)), trial
+        assert _int_median(us) == float(np.median(us)), trial
+        assert _int_median(us[: max(1, n - 1)]) == float(np.median(us[: max(1, n - 1)]))

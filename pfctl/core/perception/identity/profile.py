@@ -22,7 +22,7 @@ from pfctl.core.perception.clothes import (
     ClothesParams,
     ColorSpace,
     body_parts_window,
-    color_histogram,
+    color_histograms,
     convert,
     histogram_intersection,
 )
@@ -104,8 +104,7 @@ def describe(
         img = converted[r0:r1, c0:c1]
     else:
         img = convert(rgb[r0:r1, c0:c1], params.clothes.color_space)
-    upper = color_histogram(img, upper_mask, params.clothes, converted=True)
-    lower = color_histogram(img, lower_mask, params.clothes, converted=True)
+    upper, lower = color_histograms(img, (upper_mask, lower_mask), params.clothes, converted=True)
     face = face_box = None
     region = face_region(detection, shape) if encoder is not None and params.faces else None
     if encoder is not None and region is not None:

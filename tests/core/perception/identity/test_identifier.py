@@ -311,6 +311,39 @@ def test_histogram_tables_give_the_per_pixel_histogram_bit_for_bit() -> None:
         color_histogram(np.zeros((4, 4, 3)), np.ones((4, 4), bool), params, converted=True)
 
 
+def test_histograms_of_several_masks_in_one_pass_equal_one_at_a_time_bit_for_bit() -> None:
+    """color_histograms (describe's upper and lower body in one pass) gives each mask the
+    histogram of color_histogram alone, and of the per-pixel reference, bit for bit: disjoint,
+    overlapping and empty masks, one or three of them, in every colour space."""
+    from pfctl.core.perception.clothes import color_histograms
+
+    rng = np.random.default_rng(19)
+    for trial in range(40):
+        space = ("hsv", "rgb", "lab")[trial % 3]
+        params = ClothesParams(space, ((16, 4, 4), (8, 8, 8), (3, 5, 2))[trial % 3])  # type: ignore[arg-type]
+        img = rng.integers(0, 256, (50, 40, 3), dtype=np.uint8)
+        if space == "hsv":
+            img[..., 0] %= 180
+        if trial % 2:  # few colours, as a rendered body
+            img = img[rng.integers(0, 3, (50, 40)), rng.integers(0, 3, (50, 40))]
+        rows = np.arange(50)[:, None]
+        body = rng.random((50, 40)) < 0.7
+        masks = [body & (rows < 20), body & (rows >= 25), body & (rows >= 10) & (rows < 30)]
+        if trial % 4 == 0:
+            masks[1] = np.zeros_like(body)
+        for chosen in (masks[:2], masks, masks[1:2]):
+            got = color_histograms(img[5:45, 3:37], [m[5:45, 3:37] for m in chosen], params, True)
+            for m, h in zip(chosen, got, strict=True):
+                alone = color_histogram(img[5:45, 3:37], m[5:45, 3:37], params, converted=True)
+                if alone is None:
+                    assert h is None, trial
+                    continue
+                assert h is not None and h.dtype == alone.dtype, trial
+                assert np.array_equal(h, alone), trial
+                ref = _reference_histogram(img[5:45, 3:37], m[5:45, 3:37], params)
+                assert np.array_equal(h, ref), trial
+
+
 # -- issue 23: belief per track, confirmation, distractors, online appearance ------------------
 
 
