@@ -31,8 +31,9 @@ around the robot's ``observe``; with the camera at the tick rate, as in the ship
 every tick has one) and by whether the tick did face work (inline: a face was embedded; with the
 worker: a head crop was submitted), and each tick's time is broken into the tick's stages —
 timed by calling them one after the other, as ``Follower.tick`` does (:func:`staged_tick`) — and
-the work inside them, timed by wrapping a few methods in this process only (laser perception,
-leg classification of the tick's scans, leg detection, camera perception, person detection, Algorithm 2 identification, face detection
+the work inside them, timed by wrapping a few methods in this process only (leg classification
+of the tick's scans, laser perception, leg detection, camera perception, person detection,
+Algorithm 2 identification, face detection
 and embedding with dlib when inline, the worker's submit and poll, tracking, belief update,
 occupancy grid update, behavior tree, Algorithm 1, the gaze rule, calls into the robot, Python's
 garbage collector): per stage how many ticks ran it, its median and p99 when it ran, and its
