@@ -93,11 +93,9 @@ def since_region_entered(history: np.ndarray, regions: RegionMap) -> np.ndarray:
     """
     if len(history) == 0:
         return history
-    last = regions.locate(history[-1, 1:3])
-    inside = np.array([regions.locate(p) == last for p in history[:, 1:3]])
-    start = len(history)
-    while start > 0 and inside[start - 1]:
-        start -= 1
+    where = regions.locate_all(history[:, 1:3])  # one vectorised test per region, not per point
+    elsewhere = np.flatnonzero(where != where[-1])
+    start = int(elsewhere[-1]) + 1 if elsewhere.size else 0
     return history[start:]
 
 

@@ -39,7 +39,7 @@ the 8-connected components of frontier cells (``scipy.ndimage.label``); smaller 
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -62,6 +62,7 @@ if TYPE_CHECKING:
 __all__ = [
     "FrontierCluster",
     "closest_point",
+    "closest_points",
     "cluster_utilities",
     "find_frontiers",
     "frontier_map",
@@ -122,8 +123,9 @@ class FrontierCluster:
     """One cluster of frontier cells (§II-C).
 
     ``cells`` are ``(row, col)`` grid indices (k, 2); ``points`` their centres in the map frame
-    (k, 2); ``centroid`` the mean of ``points``; ``n_unknown`` is N of Eq. 3: the number of
-    distinct unknown cells in the 8-neighbourhoods of the cluster's cells.
+    (k, 2) (from :func:`frontiers_from_states`: read-only slices of arrays its clusters share);
+    ``centroid`` the mean of ``points``; ``n_unknown`` is N of Eq. 3: the number of distinct
+    unknown cells in the 8-neighbourhoods of the cluster's cells.
     """
 
     cells: NDArray[np.intp] = field(repr=False)
@@ -167,6 +169,18 @@ def _dilate8(mask: NDArray[np.bool_]) -> NDArray[np.bool_]:
     return out
 
 
+def _squeeze(index: NDArray[np.intp], size: int) -> tuple[NDArray[np.intp], int]:
+    """New positions of the lines ``index`` (of ``size``) with the unused lines dropped but one
+    after each run of used ones, and the new size: lines next to each other stay so, lines
+    apart stay apart, the order is kept."""
+    used = np.zeros(size + 1, dtype=bool)
+    used[index] = True
+    keep = used.copy()
+    keep[1:] |= used[:-1]
+    position = np.cumsum(keep) - 1
+    return position[index], int(position[-1]) + 1
+
+
 def frontiers_from_states(
     states: ArrayLike,
     geometry: GridGeometry,
@@ -184,50 +198,69 @@ def frontiers_from_states(
     unknown = s == UNKNOWN
     occupied = s == OCCUPIED
     candidate = (s == FREE) & _dilate8(unknown) & ~_dilate8(occupied)
-    rr, cc = np.nonzero(candidate)
+    # Cells are handled by their index in the map framed by one cell all round (frame width wf):
+    # one flat lookup per neighbour offset. np.flatnonzero: row-major, as np.nonzero (faster).
+    wf = w + 2
+    rr, cc = np.divmod(np.flatnonzero(candidate), w)
+    at = (rr + 1) * wf + (cc + 1)
+    offsets = np.array([dr * wf + dc for dr, dc in _OFFSETS])
     if rr.size:
-        # Eq. 2 at the candidates: gather the 3×3 neighbourhood of states (edge replicated).
-        padded = np.pad(s, 1, mode="edge")
-        neigh = np.stack([padded[rr + 1 + dr, cc + 1 + dc] for dr, dc in _OFFSETS], axis=1)
-        lam_lut = np.array([0.0, 1.0, 0.5])  # index by state: FREE 0, OCCUPIED 1, UNKNOWN -1
-        lamo_lut = np.array([0.5, 1.0, 0.5])
-        centre = s[rr, cc]
-        grad = np.abs(lam_lut[neigh] - lam_lut[centre][:, None]).sum(axis=1)
-        grad_o = np.abs(lamo_lut[neigh] - lamo_lut[centre][:, None]).sum(axis=1)
-        F = grad - beta * (grad_o + lamo_lut[centre] - 0.5)
+        # Eq. 2 at the candidates, their 3×3 neighbourhood of states with the map edge
+        # replicated. A candidate is free and none of those cells is occupied (the replicated
+        # ones are cells of that neighbourhood too), so Λ_o is 0.5 all over it: ‖∇Λ_o‖₁ and
+        # Λ_o − 0.5 vanish and ‖∇Λ‖₁ is 0.5 per unknown neighbour, exactly the sums of
+        # frontier_map (β·0 kept: an infinite β makes F undefined there too).
+        framed = np.empty((h + 2, wf), dtype=np.int8)
+        framed[1:-1, 1:-1] = s
+        framed[0, 1:-1], framed[-1, 1:-1] = s[0], s[-1]
+        framed[:, 0], framed[:, -1] = framed[:, 1], framed[:, -2]
+        neigh = framed.ravel()[at[:, None] + offsets]
+        F = 0.5 * np.count_nonzero(neigh == UNKNOWN, axis=1) - beta * 0.0
         keep = threshold < F
-        rr, cc = rr[keep], cc[keep]
-    frontier = np.zeros((h, w), dtype=bool)
-    frontier[rr, cc] = True
-    labels, n = ndimage.label(frontier, structure=_EIGHT)
-    if n == 0:
+        rr, cc, at = rr[keep], cc[keep], at[keep]
+    if rr.size == 0:
         return []
-    lab = labels[rr, cc]  # rr, cc are in row-major order
+    # Label the 8-connected components on the map squeezed to the rows and columns that hold
+    # frontier cells (an empty line kept between runs of them): the same neighbours, the same
+    # raster order, far fewer cells for ndimage.label.
+    r2, rows = _squeeze(rr, h)
+    c2, cols = _squeeze(cc, w)
+    frontier = np.zeros((rows, cols), dtype=bool)
+    frontier[r2, c2] = True
+    labels, n = ndimage.label(frontier, structure=_EIGHT)
+    lab = labels[r2, c2]  # rr, cc are in row-major order
     sizes = np.bincount(lab, minlength=n + 1)
-    # N: distinct unknown cells in the 8-neighbourhood of each cluster.
-    upad = np.pad(unknown, 1)
-    pairs = []
-    for dr, dc in _OFFSETS:
-        r2, c2 = rr + dr, cc + dc
-        hit = upad[r2 + 1, c2 + 1]
-        pairs.append(lab[hit].astype(np.int64) * (h * w) + (r2[hit] * w + c2[hit]))
-    unique_pairs = np.unique(np.concatenate(pairs))
-    n_unknown = np.bincount(unique_pairs // (h * w), minlength=n + 1)
+    # N: distinct unknown cells in the 8-neighbourhood of each cluster (cells off the map are
+    # not unknown), as (label, framed cell index) pairs.
+    upad = np.zeros((h + 2, wf), dtype=bool)
+    upad[1:-1, 1:-1] = unknown
+    around = at[:, None] + offsets
+    hit = upad.ravel()[around]
+    pairs = lab[:, None].astype(np.int64) * upad.size + around
+    pairs = np.sort(pairs[hit])
+    distinct = np.ones(pairs.shape, dtype=bool)
+    distinct[1:] = pairs[1:] != pairs[:-1]
+    n_unknown = np.bincount(pairs[distinct] // upad.size, minlength=n + 1)
     order = np.argsort(lab, kind="stable")
-    starts = np.searchsorted(lab[order], np.arange(1, n + 2))
-    points_all = geometry.cell_to_world(rr, cc)
+    bounds = np.searchsorted(lab[order], np.arange(1, n + 2)).tolist()
+    # Every cluster's cells and points are slices of these (read-only), in row-major order.
+    cells_all = np.stack([rr[order], cc[order]], axis=1).astype(np.intp)
+    points_all = geometry.cell_to_world(cells_all[:, 0], cells_all[:, 1])
+    cells_all.flags.writeable = False
+    points_all.flags.writeable = False
+    first_cell = (cells_all[:, 0] * w + cells_all[:, 1]).tolist()
+    sizes_list, n_unknown_list = sizes.tolist(), n_unknown.tolist()
     clusters: list[tuple[int, int, FrontierCluster]] = []
     for i in range(1, n + 1):
-        if sizes[i] < min_cells:
+        if sizes_list[i] < min_cells:
             continue
-        sel = order[starts[i - 1] : starts[i]]
-        cells = np.stack([rr[sel], cc[sel]], axis=1).astype(np.intp)
-        points = points_all[sel]
-        centroid = points.mean(axis=0)
+        a, b = bounds[i - 1], bounds[i]
+        points = points_all[a:b]
+        centroid = np.add.reduce(points, axis=0) / (b - a)  # points.mean(axis=0)
         cluster = FrontierCluster(
-            cells, points, (float(centroid[0]), float(centroid[1])), int(n_unknown[i])
+            cells_all[a:b], points, (float(centroid[0]), float(centroid[1])), n_unknown_list[i]
         )
-        clusters.append((-int(sizes[i]), int(cells[0, 0]) * w + int(cells[0, 1]), cluster))
+        clusters.append((-sizes_list[i], first_cell[a], cluster))
     clusters.sort(key=lambda t: (t[0], t[1]))
     return [c for _, _, c in clusters]
 
@@ -237,6 +270,27 @@ def closest_point(cluster: FrontierCluster, target: ArrayLike) -> NDArray[np.flo
     t = np.asarray(target, dtype=float)
     i = int(np.argmin(np.sum((cluster.points - t) ** 2, axis=1)))
     return cluster.points[i].copy()
+
+
+def closest_points(clusters: Sequence[FrontierCluster], target: ArrayLike) -> NDArray[np.float64]:
+    """:func:`closest_point` of every cluster, ``(len(clusters), 2)``: the squared distances of
+    all their points to ``target`` in one go, then each cluster's first least one."""
+    if not clusters:
+        return np.empty((0, 2))
+    t = np.asarray(target, dtype=float)
+    sizes = [len(c.points) for c in clusters]
+    points = np.concatenate([c.points for c in clusters])
+    d2 = np.sum((points - t) ** 2, axis=1)
+    starts = np.cumsum([0, *sizes[:-1]])
+    least = np.minimum.reduceat(d2, starts)
+    if np.isnan(least).any():  # np.argmin takes the first NaN: cluster by cluster
+        picks = [a + int(np.argmin(d2[a : a + k])) for a, k in zip(starts, sizes, strict=True)]
+        closest: NDArray[np.float64] = points[picks]
+        return closest
+    # The first point of each cluster at its least d²: every cluster has one.
+    at_least = np.flatnonzero(d2 == np.repeat(least, sizes))
+    closest = points[at_least[np.searchsorted(at_least, starts)]]
+    return closest
 
 
 def utility(

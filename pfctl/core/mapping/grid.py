@@ -339,9 +339,10 @@ class OccupancyGrid:
         which spares an exp() per cell.
         """
         lo = self.logodds
-        out = np.full(lo.shape, UNKNOWN, dtype=np.int8)
-        out[lo < logit(free_thresh)] = FREE
-        out[lo > logit(occupied_thresh)] = OCCUPIED
+        occupied = lo > logit(occupied_thresh)  # wins over free when the thresholds cross
+        known = occupied | (lo < logit(free_thresh))
+        # OCCUPIED 1, FREE 0, UNKNOWN -1 by arithmetic on the masks' bytes (no masked writes)
+        out: NDArray[np.int8] = occupied.view(np.int8) - (~known).view(np.int8)
         return out
 
     def entropy(self, base: float = 2.0) -> float:

@@ -32,6 +32,7 @@ shortest path length and ~1.08 times it (the 8-connected metric, 1/cos 22.5°).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property, lru_cache
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -95,6 +96,12 @@ class Traversability:
     search_box: tuple[int, int, int, int] | None = None
     margin_cells: int = 0
 
+    @cached_property
+    def framed(self) -> NDArray[np.bool_]:
+        """``blocked`` framed by blocked cells, flattened: the lookup of :func:`_sight` (made
+        once: each distance field tests many segments against it)."""
+        return _framed(self.blocked)
+
 
 def traversability(
     grid_or_free_mask: OccupancyGrid | ArrayLike,
@@ -142,7 +149,7 @@ def traversability(
     hc, wc = -(-geometry.height // f), -(-geometry.width // f)
     padded = np.zeros((hc * f, wc * f), dtype=bool)
     padded[: geometry.height, : geometry.width] = blocked
-    coarse_blocked = padded.reshape(hc, f, wc, f).any(axis=(1, 3))
+    coarse_blocked = _any_blocks(padded, f)
     coarse_geometry = GridGeometry(geometry.resolution * f, wc, hc, geometry.origin)
     margin = max(1, int(np.ceil(search_margin / coarse_geometry.resolution)))
     box = None
@@ -162,6 +169,89 @@ def traversability(
     return Traversability(geometry, blocked, f, coarse_geometry, ~coarse_blocked, box, margin)
 
 
+#: Unsigned integers as wide as f booleans: a row of f fine cells read as one number.
+_BLOCK_WORDS: dict[int, type[np.unsignedinteger[Any]]] = {
+    1: np.uint8,
+    2: np.uint16,
+    4: np.uint32,
+    8: np.uint64,
+}
+
+
+def _any_blocks(mask: NDArray[np.bool_], f: int) -> NDArray[np.bool_]:
+    """True for each ``f`` × ``f`` block of the C-contiguous ``(hc·f, wc·f)`` ``mask`` with any
+    True cell: ``mask.reshape(hc, f, wc, f).any(axis=(1, 3))``, without numpy's slow reduction
+    over two short axes (each row's ``f`` cells are read as one integer when ``f`` is 1, 2, 4
+    or 8)."""
+    hf, wf = mask.shape
+    word = _BLOCK_WORDS.get(f)
+    if word is not None:
+        cols = np.ascontiguousarray(mask).view(word) != 0
+    else:
+        cols = mask.reshape(hf, wf // f, f).any(axis=2)
+    out: NDArray[np.bool_] = cols.reshape(hf // f, f, wf // f).any(axis=1)
+    return out
+
+
+def _framed(blocked: ArrayLike) -> NDArray[np.bool_]:
+    """``blocked`` (``(height, width)``) inside a frame of blocked cells, flattened: a segment
+    sample off the map lands on the frame (:func:`_sight`)."""
+    b = np.asarray(blocked)
+    framed = np.ones((b.shape[0] + 2, b.shape[1] + 2), dtype=bool)
+    framed[1:-1, 1:-1] = b
+    return framed.ravel()
+
+
+def _samples(longest: float, step: float) -> int:
+    """Samples per segment of :func:`line_of_sight`: the longest segment every ``step``, both
+    ends included."""
+    return int(np.ceil(longest / step)) + 1
+
+
+@lru_cache(maxsize=64)
+def _fractions(n: int) -> NDArray[np.float64]:
+    """``np.linspace(0, 1, max(n, 2))``, read-only: where along a segment the samples lie."""
+    t = np.linspace(0.0, 1.0, max(n, 2))
+    t.flags.writeable = False
+    return t
+
+
+def _sight(
+    framed: NDArray[np.bool_],
+    geometry: GridGeometry,
+    a: NDArray[np.float64],
+    d: NDArray[np.float64],
+    n: int,
+) -> NDArray[np.bool_]:
+    """:func:`line_of_sight` of the segments ``a → a + d`` (``a`` and ``d`` broadcast against
+    each other, ``(..., 2)``) at ``n`` samples each, over the :func:`_framed` blocked cells of a
+    grid with ``geometry``.
+
+    The samples and their cells are computed as :func:`line_of_sight` and
+    :meth:`GridGeometry.world_to_cell` do, one coordinate at a time (each operation runs along
+    the samples); cells off the map are clamped onto the frame (blocked), so one lookup replaces
+    the bounds test.
+    """
+    t = _fractions(n)
+    cells = []
+    for axis, size in ((0, geometry.width), (1, geometry.height)):
+        u = a[..., axis, None] + d[..., axis, None] * t
+        u -= geometry.origin[axis]
+        u /= geometry.resolution
+        np.floor(u, out=u)
+        np.fmin(u, float(size), out=u)  # fmin/fmax: NaN goes to the frame too
+        np.fmax(u, -1.0, out=u)
+        cells.append(u)
+    cols, index = cells
+    width = geometry.width + 2
+    index *= width  # (row + 1) · width + (col + 1)
+    index += cols
+    index += width + 1
+    hit = framed[index.astype(np.intp)]
+    clear: NDArray[np.bool_] = ~hit.any(axis=-1)
+    return clear
+
+
 def line_of_sight(
     blocked: NDArray[np.bool_],
     geometry: GridGeometry,
@@ -173,21 +263,15 @@ def line_of_sight(
 
     ``a`` and ``b`` broadcast against each other with shape ``(..., 2)``; the result has shape
     ``(...)``. The segments are sampled every ``step`` metres (default a third of a cell), the
-    end points included.
+    end points included. ValueError when ``blocked`` is not of ``geometry``'s shape.
     """
     a = np.asarray(a, dtype=float)
-    b = np.asarray(b, dtype=float)
-    a, b = np.broadcast_arrays(a, b)
+    d = np.asarray(b, dtype=float) - a
     step = geometry.resolution / 3.0 if step is None else step
-    lengths = np.linalg.norm(b - a, axis=-1)
-    n = int(np.ceil(lengths.max(initial=0.0) / step)) + 1
-    t = np.linspace(0.0, 1.0, max(n, 2))
-    samples = a[..., None, :] + (b - a)[..., None, :] * t[:, None]
-    rows, cols = geometry.world_to_cell(samples)
-    inside = geometry.in_bounds(rows, cols)
-    hit = np.ones(rows.shape, dtype=bool)
-    hit[inside] = blocked[rows[inside], cols[inside]]
-    return ~hit.any(axis=-1)
+    if np.shape(blocked) != geometry.shape:
+        raise ValueError(f"blocked mask shape {np.shape(blocked)} != grid shape {geometry.shape}")
+    n = _samples(np.linalg.norm(d, axis=-1).max(initial=0.0), step)
+    return _sight(_framed(blocked), geometry, a, d, n)
 
 
 @dataclass(frozen=True, eq=False)
@@ -209,8 +293,15 @@ class DistanceField:
         centre + straight segment from it to the point), over cells whose segment is in line of
         sight; ``inf`` where no such cell is reachable.
         """
+        return self._at(np.asarray(points, dtype=float))
+
+    def _at(
+        self, pts: NDArray[np.float64], need: NDArray[np.bool_] | None = None
+    ) -> NDArray[np.float64]:
+        """:meth:`at` of ``pts``; with ``need`` (shape ``pts.shape[:-1]``) only of those points
+        (the others come out ``inf``), each as :meth:`at` of all of them gives it: the segments
+        are sampled as :func:`line_of_sight` would sample all of them (by the longest)."""
         tr = self.traversability
-        pts = np.asarray(points, dtype=float)
         cg = tr.coarse_geometry
         rows, cols = cg.world_to_cell(pts)
         nr = rows[..., None] + _NEIGHBOURS_3X3[:, 0]
@@ -223,13 +314,13 @@ class DistanceField:
         join = np.linalg.norm(centres - pts[..., None, :], axis=-1)
         finite = np.isfinite(base)
         if finite.any():
+            # Samples per segment as line_of_sight(centres[finite], pts[finite]) takes them.
+            n = _samples(join[finite].max(), tr.geometry.resolution / 3.0)
+            test = finite if need is None else finite & need[..., None]
             seen = np.zeros(base.shape, dtype=bool)
-            seen[finite] = line_of_sight(
-                tr.blocked,
-                tr.geometry,
-                centres[finite],
-                np.broadcast_to(pts[..., None, :], centres.shape)[finite],
-            )
+            if test.any():
+                ends = np.broadcast_to(pts[..., None, :], centres.shape)[test]
+                seen[test] = _sight(tr.framed, tr.geometry, centres[test], ends - centres[test], n)
             base = np.where(seen, base + join, np.inf)
         return base.min(axis=-1)
 
@@ -241,11 +332,14 @@ class DistanceField:
         """
         tr = self.traversability
         pts = np.asarray(points, dtype=float)
-        straight = np.linalg.norm(pts - self.start, axis=-1)
-        los = line_of_sight(tr.blocked, tr.geometry, self.start, pts)
+        away = pts - self.start
+        straight = np.linalg.norm(away, axis=-1)
+        n = _samples(straight.max(initial=0.0), tr.geometry.resolution / 3.0)
+        los = _sight(tr.framed, tr.geometry, self.start, away, n)
         if np.all(los):
             return straight
-        return np.where(los, straight, np.maximum(straight, self.at(pts)))
+        # The grid path only where the line of sight is blocked.
+        return np.where(los, straight, np.maximum(straight, self._at(pts, ~los)))
 
 
 _STEPS = tuple((dr, dc) for dr in (-1, 0, 1) for dc in (-1, 0, 1) if dr or dc)
@@ -282,16 +376,20 @@ def distance_fields(tr: Traversability, starts: ArrayLike) -> list[DistanceField
     free[1:-1, 1:-1] = tr.coarse_free[r0:r1, c0:c1]
     free = free.ravel()
     n = free.size
-    nodes = np.arange(n)
     step = np.array([dr * wp + dc for dr, dc in _STEPS])
-    dst = nodes[:, None] + step  # (n, 8); only used where the source is free (never on the pad)
-    np.clip(dst, 0, n - 1, out=dst)
-    ok = free[:, None] & free[dst]
+    # ok[v, j]: node v and the node of step j from it are free (a diagonal step also needs both
+    # cells it passes between). Shifted slices: every node off the pad has all its neighbours
+    # in range, and a node on the pad is not free.
+    ok = np.zeros((n, len(_STEPS)), dtype=bool)
     for j, (dr, dc) in enumerate(_STEPS):
-        if dr and dc:  # a diagonal step needs both cells it passes between
-            ok[:, j] &= (
-                free[np.clip(nodes + dr * wp, 0, n - 1)] & free[np.clip(nodes + dc, 0, n - 1)]
-            )
+        shifts = (step[j], dr * wp, dc) if dr and dc else (step[j],)
+        lo, hi = max(0, -min(shifts)), n - max(0, max(shifts))
+        both = free[lo:hi] & free[lo + step[j] : hi + step[j]]
+        if dr and dc:
+            both &= free[lo + dr * wp : hi + dr * wp] & free[lo + dc : hi + dc]
+        ok[lo:hi, j] = both
+    edges = np.flatnonzero(ok)  # node by node, steps in order
+    sources, steps = edges >> 3, edges & 7  # divmod by len(_STEPS) == 8
     # Virtual start nodes n .. n+k-1: edges to the 3×3 coarse cells around each start.
     nr = rows[:, None] + _NEIGHBOURS_3X3[:, 0]
     nc = cols[:, None] + _NEIGHBOURS_3X3[:, 1]
@@ -299,18 +397,26 @@ def distance_fields(tr: Traversability, starts: ArrayLike) -> list[DistanceField
     nr_c, nc_c = np.clip(nr, 0, H - 1), np.clip(nc, 0, W - 1)
     centres = cg.cell_to_world(nr_c, nc_c)
     joinable = inside & tr.coarse_free[nr_c, nc_c]
+    offsets = centres - starts[:, None, :]
+    join = np.linalg.norm(offsets, axis=-1)
     if joinable.any():
-        joinable[joinable] = line_of_sight(
-            tr.blocked,
+        n_samples = _samples(join[joinable].max(), tr.geometry.resolution / 3.0)
+        joinable[joinable] = _sight(
+            tr.framed,
             tr.geometry,
             np.broadcast_to(starts[:, None, :], centres.shape)[joinable],
-            centres[joinable],
+            offsets[joinable],
+            n_samples,
         )
-    join_len = np.linalg.norm(centres - starts[:, None, :], axis=-1) / cg.resolution
-    counts = np.concatenate([ok.sum(axis=1), joinable.sum(axis=1)])
-    indptr = np.concatenate([[0], np.cumsum(counts)])
-    indices = np.concatenate([dst[ok], ((nr_c - r0 + 1) * wp + (nc_c - c0 + 1))[joinable]])
-    weights = np.concatenate([np.broadcast_to(_STEP_LENGTHS, ok.shape)[ok], join_len[joinable]])
+    join_len = join / cg.resolution
+    counts = np.concatenate([np.bincount(sources, minlength=n), joinable.sum(axis=1)])
+    # The index arrays in the dtype scipy would cast them to (it checks them otherwise).
+    index_dtype = np.int32 if n + k + len(edges) + joinable.size < 2**31 else np.int64
+    indptr = np.concatenate([[0], np.cumsum(counts)]).astype(index_dtype)
+    indices = np.concatenate(
+        [sources + step[steps], ((nr_c - r0 + 1) * wp + (nc_c - c0 + 1))[joinable]]
+    ).astype(index_dtype)
+    weights = np.concatenate([_STEP_LENGTHS[steps], join_len[joinable]])
     graph = csr_matrix((weights, indices, indptr), shape=(n + k, n + k))
     dist = np.atleast_2d(dijkstra(graph, directed=True, indices=np.arange(n, n + k)))
     window = dist[:, :n].reshape(k, h + 2, wp)[:, 1:-1, 1:-1] * cg.resolution

@@ -36,7 +36,7 @@ from shapely.geometry import Polygon
 
 from pfctl.core.mapping.frontiers import (
     FrontierCluster,
-    closest_point,
+    closest_points,
     cluster_utilities,
     frontiers_from_states,
 )
@@ -84,6 +84,7 @@ class RegionMap:
         if len(set(self._order)) != len(self._order):
             raise ValueError(f"region names are not unique: {self._order}")
         self._polygons: dict[str, Polygon] = {}
+        self._points: dict[str, XY] = {}
         graph = nx.Graph()
         for region in layout.regions:
             poly = Polygon(region.polygon)
@@ -133,6 +134,18 @@ class RegionMap:
             if shapely.intersects_xy(self._polygons[name], x, y):
                 return name
         return None
+
+    def locate_all(self, points: ArrayLike) -> NDArray[np.intp]:
+        """:meth:`locate` of each of ``points`` (``(n, 2)``) at once, as the index of the region
+        in :attr:`names` (−1 outside every region): one vectorised shapely test per region,
+        same rule (``intersects``, the first region in layout order)."""
+        pts = np.asarray(points, dtype=float).reshape(-1, 2)
+        x, y = pts[:, 0], pts[:, 1]
+        hits = np.array([shapely.intersects_xy(self._polygons[r], x, y) for r in self._order])
+        if not len(hits):
+            return np.full(len(pts), -1, dtype=np.intp)
+        found: NDArray[np.intp] = np.where(hits.any(axis=0), hits.argmax(axis=0), -1)
+        return found
 
     def neighbours(self, name: str) -> list[str]:
         """Regions joined to ``name`` by a door, in layout order (KeyError if unknown)."""
@@ -184,11 +197,14 @@ class RegionMap:
         """The point that stands for region ``name``: its centroid, or a point surely inside
         (shapely's ``representative_point``) when the centroid of a concave region falls outside.
         """
-        poly = self._polygons[name]
-        c = poly.centroid
-        if not poly.covers(c):
-            c = poly.representative_point()
-        return (float(c.x), float(c.y))
+        point = self._points.get(name)
+        if point is None:  # once per region: the map is static
+            poly = self._polygons[name]
+            c = poly.centroid
+            if not poly.covers(c):
+                c = poly.representative_point()
+            point = self._points[name] = (float(c.x), float(c.y))
+        return point
 
 
 def _midpoint(door: Door) -> XY:
@@ -253,10 +269,8 @@ def heading_region(
     current region itself). Ties are broken by region name.
     """
     _, scores = heading_scores(history, region_map, window_s)
-    if not scores:
-        return None
-    best = min(sorted(scores), key=lambda n: scores[n])
-    if scores[best] >= 0.0:
+    best = _approached(scores)
+    if best is None:
         return None
     if min_speed > 0.0:
         w = _window(history, window_s)
@@ -265,6 +279,15 @@ def heading_region(
         if duration <= 0 or gained / duration <= min_speed:
             return None
     return best
+
+
+def _approached(scores: dict[str, float]) -> str | None:
+    """The neighbour of :func:`heading_scores` approached fastest (the most negative mean, ties
+    by name); None when there is none or it is not approached (mean ≥ 0)."""
+    if not scores:
+        return None
+    best = min(sorted(scores), key=lambda n: scores[n])
+    return None if scores[best] >= 0.0 else best
 
 
 WaypointChoice = Literal["utility", "nearest"]
@@ -403,19 +426,18 @@ def waypoint_search(
         )
     nearest = choice == "nearest"
     robot = np.asarray(robot_xy, dtype=float)[:2]
-    heading = heading_region(history, region_map, window_s)
-    target = heading
-    if target is None:
-        w = _window(history, window_s)
-        target = region_map.locate(w[-1, 1:3]) if len(w) else None
+    # heading_region, keeping the region the history ends in for the fallback
+    current, scores = heading_scores(history, region_map, window_s)
+    heading = _approached(scores)
+    target = heading if heading is not None else current
     if target is None and robot_region_fallback:
         target = region_map.locate(robot)
     target_point = region_map.region_point(target) if target is not None else None
 
     geometry = grid.geometry
     states = grid.states(free_thresh, occupied_thresh)
-    if confine_to_regions:
-        states = np.where(region_map.blocked_mask(geometry), np.int8(OCCUPIED), states)
+    if confine_to_regions:  # (states is a new array)
+        np.copyto(states, np.int8(OCCUPIED), where=region_map.blocked_mask(geometry))
     clusters = frontiers_from_states(states, geometry, beta, frontier_threshold, min_frontier_cells)
     goals: list[XY] = []
     utilities: list[float] = []
@@ -431,15 +453,15 @@ def waypoint_search(
         starts = [robot] if target_point is None or nearest else [robot, anchor]
         fields = distance_fields(tr, np.array(starts))
         # Eq. 3 for all clusters at once, one vectorised field lookup per term.
-        goal_array = np.array([closest_point(c, anchor) for c in clusters])
+        goal_array = closest_points(clusters, anchor)
         from_robot = fields[0](goal_array)
         if nearest:
             u = -from_robot
         else:
             to_l_star = fields[1](goal_array) if len(starts) == 2 else None
             u = cluster_utilities([c.n_unknown for c in clusters], from_robot, to_l_star, alpha)
-        goals = [(float(g[0]), float(g[1])) for g in goal_array]
-        utilities = [float(v) for v in u]
+        goals = [(gx, gy) for gx, gy in goal_array.tolist()]
+        utilities = u.tolist()
         if np.isfinite(u).any():
             best = int(np.argmax(np.where(np.isfinite(u), u, -np.inf)))
     common = dict(
