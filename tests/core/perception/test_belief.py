@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -249,6 +250,24 @@ def _reference_most_likely(
     return out
 
 
+def _random_belief(
+    rng: np.random.Generator, trial: int, third: Callable[[tuple[int, int]], np.ndarray]
+) -> HumanBelief:
+    """A belief on a random grid of 1-69 cells a side: by ``trial`` % 3 a few repeated values
+    (the prior, p_min, 0 and others: ties), uniform values, or ``third(shape)``."""
+    shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
+    kind = trial % 3
+    if kind == 0:
+        p = rng.choice([0.0, 0.001, 0.05, 0.3, 0.999], size=shape)
+    elif kind == 1:
+        p = rng.random(shape)
+    else:
+        p = third(shape)
+    belief = HumanBelief(GridGeometry(0.05, shape[1], shape[0], (0.0, 0.0)), BeliefParams())
+    belief.p = p
+    return belief
+
+
 def test_most_likely_equals_the_plain_greedy_with_ties() -> None:
     """Belief grids are full of equal values (the prior, p_min, 0): the peaks and their order
     are those of the plain sorted greedy, equal beliefs taken in cell order."""
@@ -256,17 +275,10 @@ def test_most_likely_equals_the_plain_greedy_with_ties() -> None:
 
     rng = np.random.default_rng(5)
     for trial in range(150):
-        shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
-        geometry = GridGeometry(0.05, shape[1], shape[0], (0.0, 0.0))
-        kind = trial % 3
-        if kind == 0:
-            p = rng.choice([0.0, 0.001, 0.05, 0.3, 0.999], size=shape)
-        elif kind == 1:
-            p = rng.random(shape)
-        else:
-            p = np.round(rng.random(shape), 2) * (rng.random(shape) > 0.3)
-        belief = HumanBelief(geometry, BeliefParams())
-        belief.p = p
+        belief = _random_belief(
+            rng, trial, lambda shape: np.round(rng.random(shape), 2) * (rng.random(shape) > 0.3)
+        )
+        p = belief.p
         for k in (1, 3, 8, 40):
             for separation in (0.0, 0.12, 1.0):
                 want = _reference_most_likely(belief, k, separation)
@@ -291,17 +303,13 @@ def test_most_likely_at_least_gives_the_leading_peaks_of_the_plain_greedy() -> N
     (the counting path), ties at the threshold, none at all."""
     rng = np.random.default_rng(21)
     for trial in range(120):
-        shape = (int(rng.integers(1, 70)), int(rng.integers(1, 70)))
-        geometry = GridGeometry(0.05, shape[1], shape[0], (0.0, 0.0))
-        kind = trial % 3
-        if kind == 0:
-            p = rng.choice([0.0, 0.001, 0.05, 0.3, 0.999], size=shape)
-        elif kind == 1:
-            p = rng.random(shape)
-        else:
-            p = np.where(rng.random(shape) < 0.02, rng.choice([0.3, 0.6, 0.9], shape), 0.05)
-        belief = HumanBelief(geometry, BeliefParams())
-        belief.p = p
+        belief = _random_belief(
+            rng,
+            trial,
+            lambda shape: np.where(
+                rng.random(shape) < 0.02, rng.choice([0.3, 0.6, 0.9], shape), 0.05
+            ),
+        )
         for k in (1, 3, 8, 40):
             for separation in (0.0, 0.12, 1.0):
                 plain = _reference_most_likely(belief, k, separation)
