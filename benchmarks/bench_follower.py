@@ -22,7 +22,8 @@ for a result that is due); ``--no-pace`` runs as fast as it can.
 It reports the median, 90th and 99th percentile and maximum wall time of one follower tick
 (:attr:`EpisodeResult.tick_seconds`: observe → perceive → predict → decide → act → log; the
 simulator's step, camera rendering and MOVE_BASE's path planning included, is not in it: a real
-robot renders nothing and its move_base plans in its own process). Goal: p99 under 20 ms. It
+robot renders nothing and its move_base plans in its own process). Goal: p99 within the
+laser's period, 25 ms at 40 Hz (issues 23 and 24; 20 ms before every scan was used). It
 also reports each tick's CPU time in the loop's thread (``time.thread_time``): the tick's own
 work, without the time the OS gave other processes (other jobs on a shared machine, the face
 worker) meanwhile — the figure to compare code changes by when the machine is busy. The
@@ -91,7 +92,8 @@ if TYPE_CHECKING:
 
 ROOT = Path(__file__).resolve().parents[1]
 CROWD = ROOT / "missions" / "house_crowd.yaml"
-GOAL_MS = 20.0
+GOAL_MS = 25.0
+"""The tick's p99 goal, ms: the period of a 40 Hz laser, so that every scan is used in time."""
 
 #: The tick's stages (DESIGN.md "One tick of the follower"), timed by calling them in order as
 #: :meth:`pfctl.core.follower.Follower.tick` does (:func:`staged_tick`); they do not overlap.
@@ -516,12 +518,12 @@ def report(
     scans = per_tick > 0
     ok = len(frames) == n and len(clock.ticks) == n and len(clock.embeddings) == n
     p99 = float(np.percentile(ms, 99)) if n else float("nan")
-    verdict = "meets" if p99 < GOAL_MS else "misses"
+    verdict = "meets" if p99 <= GOAL_MS else "misses"
     print(
         f"\nfollower tick, {mission.name}, seed {seed}: {result.sim_time:.1f} s simulated at "
         f"{mission.behavior.tick_hz:g} Hz in {result.wall_time:.1f} s wall; {mode.describe()}"
     )
-    print(f"  all ticks        {_pcts(ms)}   → p99 {verdict} the goal < {GOAL_MS:g} ms")
+    print(f"  all ticks        {_pcts(ms)}   → p99 {verdict} the goal ≤ {GOAL_MS:g} ms")
     if len(per_tick) == n and n:
         print(f"  laser scans per tick: mean {per_tick.mean():.2f}, max {per_tick.max()}")
     if len(clock.cpu) == n:
