@@ -12,7 +12,12 @@ closer than a margin to a sensed point (sliding along a wall, stopping short of 
 pure pursuit cuts the corners of a path, and people walk across it). It re-plans when obstacle
 points (laser returns that are not part of the static map) lie on the path ahead, or when the
 robot makes no progress for :data:`STUCK_TIME` seconds, marking those points as obstacles;
-after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Pure numpy: no pybullet.
+after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Like move_base's costmap,
+which clears what the laser no longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
+seconds after the laser last showed something there; while the path goes round marked points it
+is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken when it is
+:data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment does not send
+the robot round the house. Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -21,6 +26,7 @@ import math
 
 import numpy as np
 from scipy import optimize
+from scipy.spatial import cKDTree
 
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
 from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
@@ -45,6 +51,13 @@ RETRY_WAIT = 1.0
 REPLAN_PERIOD = 1.0
 #: Progress (m) after which the re-plan count starts again (a long trip may meet many people).
 REPLAN_RESET = 1.5
+#: A marked obstacle point is forgotten this long (s) after the laser last showed a point within
+#: BLOCKER_RADIUS of it (people move on; move_base's costmap clears them too).
+BLOCKER_MEMORY = 4.0
+#: While the path goes round marked points, it is planned again this often (s) …
+RECONSIDER_PERIOD = 2.0
+#: … and the new path is taken when it is at least this much shorter than the rest (m).
+RECONSIDER_GAIN = 1.0
 #: The local safety layer (:func:`keep_clear`): no velocity toward a sensed point of the static
 #: map (a wall, furniture) within the robot's radius plus this, metres …
 WALL_MARGIN = 0.06
@@ -84,6 +97,14 @@ class Navigator:
         self._since_progress = 0.0
         self._wait = 0.0
         self._blockers = np.empty((0, 2))
+        """Obstacle points marked by re-plans (map frame), planned round until forgotten."""
+        self._blocker_seen = np.empty(0)
+        """When the laser last showed each of ``_blockers`` (the goal's clock, s)."""
+        self._clock = 0.0
+        """Seconds of :meth:`update` since the goal was accepted."""
+        self._since_reconsider = 0.0
+        self._round_marks = False
+        """The path was planned round marked points (so it is reconsidered as they go)."""
         self._since_replan = math.inf
         self._rest_at_replan = math.inf
         self._unplanned = False
@@ -105,7 +126,10 @@ class Navigator:
         self.replans = 0
         self.total_replans = 0
         self.reason = ""
-        self._blockers = np.empty((0, 2))
+        self._forget_blockers()
+        self._clock = 0.0
+        self._since_reconsider = 0.0
+        self._round_marks = False
         self._since_replan = math.inf
         self._rest_at_replan = math.inf
         self._unplanned = False
@@ -142,6 +166,54 @@ class Navigator:
             self._status = NavStatus.PREEMPTED
         self.path = None
         self._unplanned = False
+
+    def _forget_blockers(self) -> None:
+        self._blockers = np.empty((0, 2))
+        self._blocker_seen = np.empty(0)
+
+    def _mark(self, points: np.ndarray) -> None:
+        """Mark ``points`` as obstacles, seen now (the newest 400 marks are kept)."""
+        self._blockers = np.vstack([self._blockers, points])[-400:]
+        stamps = np.full(len(points), self._clock)
+        self._blocker_seen = np.concatenate([self._blocker_seen, stamps])[-400:]
+
+    def _refresh_blockers(self, dynamic: np.ndarray) -> None:
+        """Marks with a sensed point within BLOCKER_RADIUS are seen now; marks not seen for
+        BLOCKER_MEMORY seconds are forgotten."""
+        if not len(self._blockers):
+            return
+        if len(dynamic):
+            d, _ = cKDTree(dynamic).query(self._blockers, distance_upper_bound=BLOCKER_RADIUS)
+            self._blocker_seen[np.isfinite(d)] = self._clock
+        keep = self._clock - self._blocker_seen <= BLOCKER_MEMORY
+        self._blockers, self._blocker_seen = self._blockers[keep], self._blocker_seen[keep]
+
+    def _planner_now(self) -> GridPlanner:
+        """The static map with the marked points as discs of BLOCKER_RADIUS."""
+        if not len(self._blockers):
+            return self.planner
+        return self.planner.with_obstacles(self._blockers, BLOCKER_RADIUS)
+
+    def _reconsider(self, pose: Pose2D, rest: float) -> None:
+        """Plan again round the marks still remembered; take the path if it is RECONSIDER_GAIN
+        shorter than the ``rest`` of the current one (not a re-plan: nothing blocked). With no
+        mark left the current path is kept unless the plain map's is that much shorter, and is
+        not reconsidered again."""
+        assert self.goal is not None
+        self._since_reconsider = 0.0
+        marked = len(self._blockers) > 0
+        try:
+            path = self._planner_now().plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+        except NoPathError:
+            return
+        if not marked:
+            self._round_marks = False
+        if float(np.linalg.norm(np.diff(path, axis=0), axis=1).sum()) < rest - RECONSIDER_GAIN:
+            self.path = path
+            self._round_marks = marked
+            self._best = math.inf
+            self._since_progress = 0.0
+            self._rest_at_replan = self._remaining(np.array([pose.x, pose.y]))[0]
 
     def _reset_progress(self) -> None:
         self._best = math.inf
@@ -235,17 +307,14 @@ class Navigator:
             self.reason = f"no way through after {MAX_REPLANS} re-plans"
             return
         if len(blockers):
-            self._blockers = np.vstack([self._blockers, blockers])[-400:]
-        planner = (
-            self.planner.with_obstacles(self._blockers, BLOCKER_RADIUS)
-            if len(self._blockers)
-            else self.planner
-        )
+            self._mark(blockers)
+        self._since_reconsider = 0.0
         try:
-            self.path = planner.plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+            self.path = self._planner_now().plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+            self._round_marks = len(self._blockers) > 0
         except NoPathError as err:
             self.reason = str(err)
-            self._blockers = np.empty((0, 2))  # the blocker may move on: try the plain map next
+            self._forget_blockers()  # the blocker may move on: try the plain map next
             self._wait = RETRY_WAIT
         self._since_progress = 0.0
         self._since_replan = 0.0
@@ -280,7 +349,14 @@ class Navigator:
                 return STOP
             wz = float(np.clip(1.5 * yaw_err, -self.max_angular_speed, self.max_angular_speed))
             return Twist2D(0.0, 0.0, wz)
+        dynamic = self._dynamic(obstacle_points)
+        self._clock += dt
+        self._since_reconsider += dt
+        self._refresh_blockers(dynamic)
         rest, i, proj = self._remaining(xy)
+        if self._round_marks and self._since_reconsider >= RECONSIDER_PERIOD:
+            self._reconsider(pose, rest)
+            rest, i, proj = self._remaining(xy)
         self._since_replan += dt
         if rest < self._rest_at_replan - REPLAN_RESET:
             self.replans = 0
@@ -291,7 +367,6 @@ class Navigator:
             self._since_progress = 0.0
         else:
             self._since_progress += dt
-        dynamic = self._dynamic(obstacle_points)
         blockers = self._blocked(self._ahead(i, proj, CHECK_AHEAD), dynamic)
         if len(blockers) and self._since_replan < REPLAN_PERIOD:
             return STOP  # just re-planned and still blocked: wait for the next re-plan

@@ -102,6 +102,35 @@ def test_replans_around_a_blocker(mission: Mission, planner: GridPlanner) -> Non
     assert np.linalg.norm(xy - blocker, axis=1).min() > 0.2 + mission.robot.radius
 
 
+def test_a_door_blocked_for_a_moment_is_taken_once_clear(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """A person stands in the kitchen's door to the hall for the first 4 s, then walks off out
+    of sight. The robot plans round her (through the living room), forgets her once the laser
+    no longer shows her there, and goes through that door after all: not round the house."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 3.3), Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office
+    person = np.array([2.3, 4.0])
+    ring = person + 0.2 * np.column_stack(
+        (np.cos(np.linspace(0, 2 * np.pi, 24)), np.sin(np.linspace(0, 2 * np.pi, 24)))
+    )
+    clock = {"t": 0.0}
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        clock["t"] += DT
+        return ring if clock["t"] <= 4.0 else np.empty((0, 2))
+
+    nav.start(goal, start)
+    poses, _ = _drive(nav, start, 200.0, seen)
+    assert nav.status is NavStatus.SUCCEEDED
+    assert nav.total_replans >= 1  # it did plan round her
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert not np.any(xy[:, 0] > 5.0)  # never into the living room, east of x = 5 m
+    through_door = (np.abs(xy[:, 1] - 4.0) < 0.15) & (xy[:, 0] > 1.9) & (xy[:, 0] < 2.7)
+    assert through_door.any()
+    assert len(poses) * DT < 60.0  # the kitchen door's way takes ~35 s; round the house ~75 s
+
+
 def test_fully_blocked_door_aborts_after_bounded_replans(
     mission: Mission, planner: GridPlanner
 ) -> None:
