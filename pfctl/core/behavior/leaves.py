@@ -97,6 +97,18 @@ class Leaf(py_trees.behaviour.Behaviour):
         target = self.target
         return target is not None and self.t - target.last_detected <= max_age
 
+    def hold_on_target(self, since: float) -> bool:
+        """Stop and point the camera at the target's track when it was detected at ``since`` or
+        later but not lately: a search that showed her for a moment — her face decided on a
+        frame the sweep has since turned away from — looks back at her, so she is detected
+        again and followed, rather than lost again at once. False (nothing done) otherwise."""
+        target = self.target
+        if target is None or target.last_detected < since:
+            return False
+        self.intents.stop()
+        self.intents.look_at(target.xy, "target")
+        return True
+
 
 # -- conditions -----------------------------------------------------------------------------------
 
@@ -284,7 +296,9 @@ class GoToPrediction(Action):
 class LookAround(Action):
     """Sweep the head ±``pan`` over ``seconds`` and, with ``turn``, turn the base once around.
     SUCCESS as soon as the target is detected; FAILURE when the sweep ends without it — the
-    prediction (if any) is then used up, so the tree moves on (Fig. 2: way-point search)."""
+    prediction (if any) is then used up, so the tree moves on (Fig. 2: way-point search). A
+    target named during the sweep but not detected lately is looked back at
+    (:meth:`Leaf.hold_on_target`)."""
 
     spec = LeafSpec(
         "look_around",
@@ -304,6 +318,8 @@ class LookAround(Action):
     def act(self) -> Status:
         if self.visible():
             return Status.SUCCESS
+        if self.hold_on_target(self._start):
+            return Status.RUNNING
         elapsed = self.t - self._start
         seconds = float(self.params["seconds"])
         if elapsed >= seconds:
@@ -328,7 +344,8 @@ class WaypointSearch(Action):
     again — a frontier still there is followed along to its next unvisited point; when every
     frontier left has been visited, it turns in place to look and starts
     afresh. RUNNING until the target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing
-    at all to search (no region to go to)."""
+    at all to search (no region to go to). A target named during the search but not detected
+    lately is looked back at (:meth:`Leaf.hold_on_target`)."""
 
     spec = LeafSpec(
         "waypoint_search",
@@ -356,6 +373,7 @@ class WaypointSearch(Action):
     LOOK_PAN: ClassVar[float] = 0.9
 
     def initialise(self) -> None:
+        self._start = self.t
         self._decision: WaypointDecision | None = None
         self._decided_at = -math.inf
         self._visited: list[tuple[float, float]] = []
@@ -441,6 +459,8 @@ class WaypointSearch(Action):
     def act(self) -> Status:
         if self.visible():
             return Status.SUCCESS
+        if self.hold_on_target(self._start):
+            return Status.RUNNING
         if self.world.search.strategy == "belief" and self.world.whereabouts is not None:
             status = self._act_belief()
             if status is not None:

@@ -18,8 +18,15 @@ from pfctl.app.follower import build_follower
 from pfctl.app.perception import build_perception
 from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.simulation import SimOptions, SimRobot
-from pfctl.core.behavior.blackboard import PredictionState, Sighting, new_namespace
-from pfctl.core.behavior.leaves import WaypointSearch
+from pfctl.core.behavior.blackboard import (
+    PredictionState,
+    Sighting,
+    TargetState,
+    new_namespace,
+)
+from pfctl.core.behavior.intents import Intents, LookAt, Stop
+from pfctl.core.behavior.leaves import LookAround, WaypointSearch
+from pfctl.core.control import ControlParams
 from pfctl.core.episode import TickRecord
 from pfctl.core.follower import Follower
 from pfctl.core.mapping.frontiers import FrontierCluster
@@ -239,6 +246,40 @@ def test_a_visited_frontier_still_there_is_followed_along_not_dropped() -> None:
     leaf._visited.extend([(0.5, 7.8), (1.3, 7.8), (2.0, 7.8)])
     done = leaf._unvisited(_decision(points, (3.0, 7.5)))
     assert done.reason == "visited_fallback" and done.waypoint == (3.0, 7.5)
+
+
+@pytest.mark.parametrize(
+    ("leaf_class", "params"),
+    [
+        (LookAround, {"seconds": 8.0, "pan": 1.4, "turn": True}),
+        (WaypointSearch, {"tolerance": 0.4}),
+    ],
+)
+def test_a_target_named_during_a_search_is_looked_back_at(
+    leaf_class: type[LookAround | WaypointSearch], params: dict[str, Any]
+) -> None:
+    """Seed 6 of the randomized house: the sweep showed her at 33.8 s, her face named her on
+    that frame, and the sweep turned on, so she was lost again. Named during the search but
+    not detected lately, she is looked back at with the base stopped; a track coasting since
+    before the search began is not."""
+    namespace = new_namespace()
+    writer = py_trees.blackboard.Client(name="test", namespace=namespace)
+    for key in ("t", "target", "intents"):
+        writer.register_key(key, access=Access.WRITE)
+    intents = Intents(ControlParams(), None)  # type: ignore[arg-type]  # stop, look_at only
+    writer.t, writer.target, writer.intents = 10.0, None, intents
+    leaf = leaf_class(leaf_class.spec.name, namespace, params)
+    leaf.initialise()  # the search begins at 10 s
+    writer.t = 11.0
+    writer.target = TargetState(7, 2.0, 3.0, 0.0, 0.0, last_detected=10.2)
+    intents.begin(11.0, Pose2D(0.0, 0.0))
+    assert leaf.act() is Status.RUNNING
+    assert intents.base == Stop() and intents.base_mode == "stop"
+    assert intents.head == [LookAt((2.0, 3.0), "target")]
+    writer.target = TargetState(7, 2.0, 3.0, 0.0, 0.0, last_detected=9.5)
+    intents.begin(11.0, Pose2D(0.0, 0.0))
+    assert not leaf.hold_on_target(10.0)
+    assert intents.base is None and intents.head == []
 
 
 def test_stop_leaf_succeeds_and_close_stops_the_base_twice_safely(empty_house: Mission) -> None:
