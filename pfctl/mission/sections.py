@@ -293,6 +293,7 @@ class SearchConfig(CoreSection, core=SearchParams):
     min_frontier_cells: FromCore
     waypoint_choice: FromCore
     strategy: FromCore
+    never_seen_strategy: FromCore
     prediction_goal: FromCore
     look_s: FromCore
 

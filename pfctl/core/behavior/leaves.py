@@ -344,8 +344,11 @@ class WaypointSearch(Action):
     again — a frontier still there is followed along to its next unvisited point; when every
     frontier left has been visited, it turns in place to look and starts
     afresh. RUNNING until the target is detected (SUCCESS); FAILURE when Algorithm 1 has nothing
-    at all to search (no region to go to). A target named during the search but not detected
-    lately is looked back at (:meth:`Leaf.hold_on_target`)."""
+    at all to search (no region to go to). With the strategy ``belief`` — ``search.strategy``
+    for a target lost, ``search.never_seen_strategy`` for one not seen yet in the run — it
+    looks where the belief over where she can be says (:meth:`_act_belief`), and uses
+    Algorithm 1 only when that belief has no place left to look. A target named during the
+    search but not detected lately is looked back at (:meth:`Leaf.hold_on_target`)."""
 
     spec = LeafSpec(
         "waypoint_search",
@@ -461,7 +464,9 @@ class WaypointSearch(Action):
             return Status.SUCCESS
         if self.hold_on_target(self._start):
             return Status.RUNNING
-        if self.world.search.strategy == "belief" and self.world.whereabouts is not None:
+        search = self.world.search
+        strategy = search.strategy if self.last_seen is not None else search.never_seen_strategy
+        if strategy == "belief" and self.world.whereabouts is not None:
             status = self._act_belief()
             if status is not None:
                 return status

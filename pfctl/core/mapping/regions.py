@@ -327,6 +327,13 @@ class SearchParams:
         " the most probable room over the time to get there and look, from its doorway first;"
         " ``missions/house_belief_search.yaml``).",
     )
+    never_seen_strategy: SearchStrategy = param(
+        "belief",
+        "How way-point search looks for a target not seen yet in the run (``pfctl search``):"
+        " ``belief`` (every room she can be in alike, emptied where the camera looked; the next"
+        " place is the most probable room over the time to get there and look, from its"
+        " doorway first) or ``paper`` (Algorithm 1's frontiers, with no heading region).",
+    )
     prediction_goal: PredictionGoal = param(
         "path",
         "Where go_to_prediction drives after a loss: ``path`` (§II-E, the paper: the end of"

@@ -199,11 +199,46 @@ def test_the_paper_strategy_keeps_algorithm_1(empty_house: Mission) -> None:
     assert waypoints and {w.heading_region for w in waypoints} == {"office"}
 
 
+def _never_seen(mission: Mission, strategy: str) -> Mission:
+    """``mission`` with the strategy for a target not seen yet (the lost one's stays paper)."""
+    search = mission.search.model_copy(
+        update={"strategy": "paper", "never_seen_strategy": strategy}
+    )
+    return mission.model_copy(update={"search": search})
+
+
+@pytest.mark.parametrize("strategy", ["belief", "paper"])
+def test_a_target_never_seen_is_searched_for_by_never_seen_strategy(
+    empty_house: Mission, strategy: str
+) -> None:
+    """pfctl search's case: nobody seen yet. With ``belief`` the robot drives to a room's
+    doorway and sweeps the head over rooms, Algorithm 1 unused; with ``paper`` it goes by
+    Algorithm 1's frontiers."""
+    mission = _never_seen(empty_house, strategy)
+    with SimRobot(sim_config(mission), SimOptions(camera=False)) as robot:
+        follower = _follower(mission, robot, {"action": "waypoint_search"})
+        records = _run(follower, robot, 20.0)
+        follower.close()
+    assert all(r.action == "waypoint_search" for r in records)
+    if strategy == "paper":
+        assert follower.log.waypoints
+        return
+    assert follower.log.waypoints == []
+    doors = [
+        (0.5 * (d.segment[0][0] + d.segment[1][0]), 0.5 * (d.segment[0][1] + d.segment[1][1]))
+        for d in mission.layout().doors
+    ]
+    goals = [r.goal for r in records if r.goal is not None]
+    assert any(min(math.dist(g, d) for d in doors) < 0.3 for g in goals)
+    assert any(r.gaze == "sweep" for r in records)
+
+
 def _leaf_with_pose(pose: Pose2D) -> WaypointSearch:
     namespace = new_namespace()
     writer = py_trees.blackboard.Client(name="test", namespace=namespace)
-    writer.register_key("pose", access=Access.WRITE)
-    writer.pose = pose
+    for key in ("pose", "t"):
+        writer.register_key(key, access=Access.WRITE)
+    writer.pose, writer.t = pose, 0.0
     leaf = WaypointSearch("waypoint_search", namespace, {"tolerance": 0.4})
     leaf.initialise()
     return leaf
