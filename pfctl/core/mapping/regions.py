@@ -328,11 +328,11 @@ class SearchParams:
         " ``missions/house_belief_search.yaml``).",
     )
     never_seen_strategy: SearchStrategy = param(
-        "belief",
+        "paper",
         "How way-point search looks for a target not seen yet in the run (``pfctl search``):"
-        " ``belief`` (every room she can be in alike, emptied where the camera looked; the next"
-        " place is the most probable room over the time to get there and look, from its"
-        " doorway first) or ``paper`` (Algorithm 1's frontiers, with no heading region).",
+        " ``paper`` (Algorithm 1's frontiers, with no heading region) or ``belief`` (every room"
+        " she can be in alike, emptied where the camera looked; the next place is the most"
+        " probable room over the time to get there and look, from its doorway first).",
     )
     prediction_goal: PredictionGoal = param(
         "path",
