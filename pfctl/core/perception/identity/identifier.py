@@ -86,6 +86,10 @@ if TYPE_CHECKING:
 #: Stamps this close count as equal (simulated clocks add up float steps).
 STAMP_EPS = 1e-6
 
+#: Clothes measured this long ago or less count as a track's clothes now (two settled tracks
+#: are measured every ``clothes_recheck_s``, 0.5 s by default).
+FRESH_CLOTHES_S = 1.0
+
 #: Numbers the identifiers, for their job keys.
 _IDENTIFIERS = itertools.count()
 
@@ -162,6 +166,9 @@ class _Evidence:
     """Stamp of the frame of the newest face sample that matched hers."""
     streak_since: float = math.inf
     """When the current run of identifications at TARGET began."""
+    below_since: float = math.inf
+    """When the current run of identifications below TARGET began (a named track in doubt
+    for ``doubt_s`` loses the name)."""
 
     def face(self, recent: int) -> float | None:
         """The median distance of the newest ``recent`` face samples (None: no face yet): a
@@ -169,6 +176,14 @@ class _Evidence:
         if not self.face_distances:
             return None
         return float(np.median(self.face_distances[-recent:]))
+
+    def clothes_now(self, recent: int) -> float | None:
+        """The median clothes similarity of the newest ``recent`` samples (None: never
+        measured): a track the tracker slid onto someone else shows it within a few samples,
+        where the mean over the track's life would hide it for long."""
+        if not self.clothes:
+            return None
+        return float(np.median(self.clothes[-recent:]))
 
 
 @dataclass(frozen=True)
@@ -440,7 +455,8 @@ class TargetIdentifier:
             return True
         if ev.face_distances:  # a face decides; clothes do not enter the decision
             return False
-        return abs(float(np.mean(ev.clothes)) - p.clothes_similarity) < p.clothes_margin
+        clothes = ev.clothes_now(p.clothes_recent)
+        return clothes is None or abs(clothes - p.clothes_similarity) < p.clothes_margin
 
     def _face_due(self, ev: _Evidence, t: float) -> bool:
         """Whether the track's face should be searched in the frame stamped ``t``."""
@@ -529,7 +545,7 @@ class TargetIdentifier:
         p = self.params
         face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
-        clothes = float(np.mean(ev.clothes)) if ev.clothes else None
+        clothes = ev.clothes_now(p.clothes_recent)
         now = ev.last_seen
         if face_d is not None and face_d >= p.face_distance:
             self._rejected_by_face(track_id, ev, clothes, now)
@@ -557,8 +573,10 @@ class TargetIdentifier:
         if decision is Decision.TARGET:
             ev.streak_since = min(ev.streak_since, now) if ev.streak else now
             ev.streak += 1
+            ev.below_since = math.inf
         else:
             ev.streak, ev.streak_since = 0, math.inf
+            ev.below_since = min(ev.below_since, now)
         return TrackIdentity(
             track_id=track_id,
             decision=decision,
@@ -593,11 +611,12 @@ class TargetIdentifier:
         if now - self._look_alike_at <= p.look_alike_memory_s:
             return True
         for tid, other in self._tracks.items():
+            clothes = other.clothes_now(p.clothes_recent)
             if (
                 tid != track_id
-                and other.clothes
                 and other.legs_seen
-                and float(np.mean(other.clothes)) >= p.clothes_similarity
+                and clothes is not None
+                and clothes >= p.clothes_similarity
             ):
                 return True
         return False
@@ -610,7 +629,7 @@ class TargetIdentifier:
         about: her clothes are no evidence then); else no one — she is lost, and the robot
         searches."""
         named = self._latest.get(self._named) if self._named is not None else None
-        if named is not None and named.decision is not Decision.NOT_TARGET:
+        if named is not None and not self._doubted(named, t):
             fresher = self._fresher_face(self._named, self._tracks[self._named].last_match)
             if fresher is None:
                 self._learn_online(t)
@@ -631,6 +650,14 @@ class TargetIdentifier:
             if best is None or key > best[0]:
                 best = (key, tid)
         self._named = None if best is None else best[1]
+
+    def _doubted(self, named: TrackIdentity, t: float) -> bool:
+        """Whether the named track has lost the name: decided NOT_TARGET, or below TARGET (a
+        face that does not quite match, clothes that stopped matching) for ``doubt_s``."""
+        if named.decision is Decision.NOT_TARGET:
+            return True
+        below = self._tracks[named.track_id].below_since
+        return t - below >= self.params.doubt_s - STAMP_EPS
 
     def _confirmed(self, ev: _Evidence, t: float) -> bool:
         """Whether a track at TARGET without a face has been so long enough to be named:
@@ -699,6 +726,7 @@ class TargetIdentifier:
                 for b, (bx, by) in xy.items()
             )
         }
+        self._note_two_in_her_clothes(t, tracks)
         her = self._named
         ev = self._tracks.get(her) if her is not None else None
         if her is None or ev is None or her not in xy:
@@ -717,6 +745,34 @@ class TargetIdentifier:
                 other.distractor = "coexisted"
             if other.distractor is not None:
                 self.distractors.remember(tid, (x, y), t, "coexisted", other.upper, other.lower)
+
+    def _note_two_in_her_clothes(
+        self, t: float, tracks: Sequence[tuple[int, float, float, bool]]
+    ) -> None:
+        """Two detected people in her clothes at least ``coexist_distance`` apart at once: one
+        of them at most is her, so a look-alike is about — remembered for
+        ``look_alike_memory_s``, as a look-alike rejected by face is, so that when one of the two
+        is lost the other is not named on her clothes alone (item 2). Only people with legs and
+        clothes measured within :data:`FRESH_CLOTHES_S` count (a track's old samples may be of
+        someone else)."""
+        p = self.params
+        dressed: list[tuple[float, float]] = []
+        for tid, x, y, detected in tracks:
+            ev = self._tracks.get(tid)
+            if not detected or ev is None or not ev.legs_seen:
+                continue
+            clothes = ev.clothes_now(p.clothes_recent)
+            if (
+                clothes is not None
+                and clothes >= p.clothes_similarity
+                and t - ev.last_clothes <= FRESH_CLOTHES_S + STAMP_EPS
+            ):
+                dressed.append((x, y))
+        if any(
+            math.hypot(ax - bx, ay - by) >= p.coexist_distance
+            for (ax, ay), (bx, by) in itertools.combinations(dressed, 2)
+        ):
+            self._look_alike_at = max(self._look_alike_at, t)
 
     def identity(self, track_id: int) -> TrackIdentity | None:
         """The latest identity of a track (None if never observed or forgotten)."""

@@ -98,10 +98,25 @@ class IdentityParams:
         unit="s",
         ge=0,
     )
+    doubt_s: float = param(
+        1.0,
+        "A named track whose belief stays below the accepting log-odds this long (a face that"
+        " does not quite match, clothes that stopped matching) loses the name: she is lost"
+        " rather than followed on doubt.",
+        unit="s",
+        ge=0,
+    )
+    clothes_recent: int = param(
+        5,
+        "A track's clothes evidence is the median similarity of its newest this many samples"
+        " (a track the tracker slid onto someone else shows it within a few samples).",
+        ge=1,
+    )
     look_alike_memory_s: float = param(
         120.0,
-        "After a person in her clothes was found not to be her (by face, or seen beside her),"
-        " her clothes are no evidence for this long (a look-alike is about).",
+        "After a person in her clothes was found not to be her (by face, or seen beside her,"
+        " or two people in her clothes were tracked apart at once), her clothes are no evidence"
+        " for this long (a look-alike is about).",
         unit="s",
         ge=0,
     )

@@ -476,3 +476,52 @@ def test_a_face_too_small_to_tell_is_no_evidence_either_way(learned) -> None:
     default = TargetIdentifier(profile, params, encoder)
     rejected = default.observe(2, 0.0, True, *reversed(_picture(RED, OTHER_FACE)))
     assert rejected.decision is Decision.NOT_TARGET and default.face_stats.too_small == 0
+
+
+def test_two_people_in_her_clothes_apart_at_once_leave_her_clothes_no_evidence() -> None:
+    """No faces: tracks 1 and 2 both in her clothes, 3 m apart at once, so one of them at most
+    is her. When track 1 is lost, track 2 alone is not named on clothes (a look-alike is about,
+    remembered); two tracks in her clothes 0.5 m apart (the tracker split one person) are no
+    such evidence, and the one left is named."""
+    params = IdentityParams(faces=False, confirm_frames=5, confirm_s=0.5)
+    img, det = _shirt((80, 150), (RED,))
+    profile = learn_profile([describe(img, det, params)], params)
+    for gap, named_after in ((3.0, None), (0.5, 2)):
+        ident = TargetIdentifier(profile, params)
+        for k in range(10):
+            t = 0.1 * k
+            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, gap, True)])
+            ident.observe(1, t, True, replace(det, position=(2.0, 0.0, 1.0)), img)
+            ident.observe(2, t, True, replace(det, position=(2.0, gap, 1.0)), img)
+            assert ident.target_track() is None, (gap, t)  # each sees the other in her clothes
+        ident.forget(1)
+        for k in range(10, 40):
+            t = 0.1 * k
+            ident.note_tracks(t, [(2, 2.0, gap, True)])
+            ident.observe(2, t, True, replace(det, position=(2.0, gap, 1.0)), img)
+        assert ident.target_track() == named_after, gap
+
+
+def test_a_named_track_slid_onto_someone_else_loses_the_name_after_doubt_s() -> None:
+    """No faces: track 1, named on her clothes, slides onto a person in green. Its newest
+    clothes samples stop matching, its belief falls below accepting, and ``doubt_s`` later it
+    is no longer the target (she is lost, not followed on doubt). One odd sample among hers
+    does not do it."""
+    params = IdentityParams(faces=False, confirm_frames=3, confirm_s=0.2, clothes_recheck_s=0.0)
+    red, green = _shirt((80, 150), (RED,)), _shirt((80, 150), (GREEN,))
+    profile = learn_profile([describe(*red, params)], params)
+    ident = TargetIdentifier(profile, params)
+    for k in range(30):  # 3 s of her, one frame of it hidden by a green sleeve
+        img, det = green if k == 20 else red
+        ident.observe(1, 0.1 * k, True, det, img)
+        if k >= 3:
+            assert ident.target_track() == 1, k
+    named = []
+    for k in range(30, 60):
+        img, det = green
+        ident.observe(1, 0.1 * k, True, det, img)
+        named.append(ident.target_track())
+    below = next(k for k, n in enumerate(named) if n is None)
+    # the median of the newest 5 turns at the third green sample; then doubt_s (1 s) passes
+    assert named[:below] == [1] * below and 10 <= below <= 14
+    assert named[below:] == [None] * (len(named) - below)
