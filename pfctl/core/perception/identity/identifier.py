@@ -15,11 +15,17 @@ the same way. When a track has seen faces both ways (a bad detection, or a track
 swapped onto someone else), the median of its newest ``face_recent`` face distances decides.
 
 **Who is the target** is a name, not a choice made again each frame (issue 23): the named track
-stays the target while the tracker holds it and it is not decided NOT_TARGET — unless another
-track shows her face more recently by ``face_recheck_s`` (the named one was swapped). A new
+stays the target while the tracker holds it and it is not decided NOT_TARGET nor below TARGET
+for ``doubt_s`` (a face that does not quite match, clothes that stopped matching: she is lost
+rather than followed on doubt) — unless another track shows her face more recently by
+``face_recheck_s`` (the named one was swapped). A new
 track is named at once on a face match, else only after ``confirm_frames`` identifications in a
 row at TARGET over ``confirm_s`` at least (time to go and see the face); while a look-alike is
-about, clothes are no evidence, so only a face names anyone and otherwise she is lost. People
+about, clothes are no evidence, so only a face names anyone and otherwise she is lost. A
+look-alike is about while another track matches her clothes, and for ``look_alike_memory_s``
+after a person in her clothes was rejected by face, marked a distractor, or tracked at least
+``coexist_distance`` from another person in her clothes at once (one of the two at most is
+her). People
 found not to be her are remembered (:mod:`~pfctl.core.perception.identity.distractors`):
 rejected by face, or seen at the same time as her face-confirmed track away from her
 (:meth:`TargetIdentifier.note_tracks`); a new track where one of them was lost stays rejected.
@@ -34,13 +40,13 @@ is found again.
 
 Clothes are measured on every observation until the track's clothes evidence is **settled**:
 ``clothes_settled`` samples and either a face deciding the track (then clothes no longer enter
-Algorithm 2's decision at all) or a mean similarity at least ``clothes_margin`` away from the
+Algorithm 2's decision at all) or a similarity (below) at least ``clothes_margin`` away from the
 ``clothes_similarity`` threshold. A settled track's clothes are measured again only every
 ``clothes_recheck_s`` (a histogram pair per person and frame adds up in a crowd;
-benchmarks/bench_identity.py measures it). The decision is the mean S over the samples; a settled
-track has fewer of them, each weighing more, so new evidence moves its mean about as fast in
-time as on every frame, and a track whose mean comes back within the margin of the threshold is
-measured on every frame again.
+benchmarks/bench_identity.py measures it). The decision is the median S of the newest
+``clothes_recent`` samples, so a track the tracker slid onto someone else shows it within a few
+samples, and one odd sample (an arm across the shirt) does not; a track whose median comes back
+within the margin of the threshold is measured on every frame again.
 
 The face search itself (dlib's HOG detector and ResNet embedding, far more than a tick's budget
 per face; benchmarks/bench_identity.py) runs inline by default, or — given a
@@ -120,7 +126,8 @@ class TrackIdentity:
     """Median face distance to the profile over the track's face samples (None: no face yet)."""
     best_face_distance: float | None
     clothes_similarity: float | None
-    """Mean clothes similarity S over the track's observations (None: never measured)."""
+    """Clothes similarity S: the median of the track's newest ``clothes_recent`` samples (None:
+    never measured)."""
     face_samples: int
     clothes_samples: int
     observations: int

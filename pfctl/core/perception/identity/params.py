@@ -66,7 +66,8 @@ class IdentityParams:
     similarity is at least ``clothes_margin`` from ``clothes_similarity``
     (:mod:`~pfctl.core.perception.identity.identifier`)."""
     clothes_margin: float = 0.15
-    """How far from the threshold a settled track's mean clothes similarity is."""
+    """How far from the threshold a settled track's clothes similarity (the median of its
+    newest ``clothes_recent`` samples) is."""
     clothes_recheck_s: float = 0.5
     """How often a settled track's clothes are measured, seconds (0: every observation)."""
     face_timing: FaceTimingSetting = param(
