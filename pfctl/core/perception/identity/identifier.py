@@ -46,7 +46,9 @@ Algorithm 2's decision at all) or a similarity (below) at least ``clothes_margin
 benchmarks/bench_identity.py measures it). The decision is the median S of the newest
 ``clothes_recent`` samples, so a track the tracker slid onto someone else shows it within a few
 samples, and one odd sample (an arm across the shirt) does not; a track whose median comes back
-within the margin of the threshold is measured on every frame again.
+within the margin of the threshold is measured on every frame again, and so is the named track's.
+A track whose clothes turn clearly unlike hers after her face was seen on it has slid onto
+someone else: its faces are forgotten and it loses the name at once.
 
 The face search itself (dlib's HOG detector and ResNet embedding, far more than a tick's budget
 per face; benchmarks/bench_identity.py) runs inline by default, or — given a
@@ -176,6 +178,8 @@ class _Evidence:
     below_since: float = math.inf
     """When the current run of identifications below TARGET began (a named track in doubt
     for ``doubt_s`` loses the name)."""
+    unlike_since: float = math.inf
+    """Since when the track's clothes have been clearly unlike hers (inf: they are not)."""
 
     def face(self, recent: int) -> float | None:
         """The median distance of the newest ``recent`` face samples (None: no face yet): a
@@ -454,12 +458,14 @@ class TargetIdentifier:
     def _clothes_due(self, ev: _Evidence, t: float) -> bool:
         """Whether the track's clothes (Algorithm 2's histogram intersection) should be
         measured in the frame stamped ``t``: always until its clothes evidence is settled, then
-        every ``clothes_recheck_s`` (module docstring)."""
+        every ``clothes_recheck_s`` (module docstring); the named track's always."""
         p = self.params
         if len(ev.clothes) < p.clothes_settled or t - ev.last_clothes >= (
             p.clothes_recheck_s - STAMP_EPS
         ):
             return True
+        if self._named is not None and ev is self._tracks.get(self._named):
+            return True  # hers: a slide onto someone else shows within a few frames
         if ev.face_distances:  # a face decides; clothes do not enter the decision
             return False
         clothes = ev.clothes_now(p.clothes_recent)
@@ -550,6 +556,7 @@ class TargetIdentifier:
 
     def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
         p = self.params
+        self._check_unlike(ev, ev.clothes_now(p.clothes_recent), ev.last_seen)
         face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
         clothes = ev.clothes_now(p.clothes_recent)
@@ -600,6 +607,23 @@ class TargetIdentifier:
             face_box=face_box,
             log_odds=lo,
         )
+
+    def _check_unlike(self, ev: _Evidence, clothes: float | None, now: float) -> None:
+        """A track whose clothes turn clearly unlike hers (``clothes_margin`` below the
+        threshold) after her face was seen on it has slid onto someone else (the tracker
+        swapped it in a crowd): the faces it showed before were another person's, so they are
+        forgotten, and a name it holds goes at once (:meth:`_doubted`)."""
+        p = self.params
+        unlike = clothes is not None and clothes < p.clothes_similarity - p.clothes_margin
+        if not unlike:
+            ev.unlike_since = math.inf
+            return
+        if math.isfinite(ev.unlike_since):
+            return
+        ev.unlike_since = now
+        if math.isfinite(ev.last_match):
+            ev.face_distances.clear()
+            ev.last_match = ev.last_face = -math.inf
 
     def _rejected_by_face(
         self, track_id: int, ev: _Evidence, clothes: float | None, now: float
@@ -659,12 +683,15 @@ class TargetIdentifier:
         self._named = None if best is None else best[1]
 
     def _doubted(self, named: TrackIdentity, t: float) -> bool:
-        """Whether the named track has lost the name: decided NOT_TARGET, or below TARGET (a
-        face that does not quite match, clothes that stopped matching) for ``doubt_s``."""
+        """Whether the named track has lost the name: decided NOT_TARGET; its clothes clearly
+        unlike hers with no face of hers seen since (:meth:`_check_unlike`); or below TARGET
+        (a face that does not quite match, clothes that stopped matching) for ``doubt_s``."""
         if named.decision is Decision.NOT_TARGET:
             return True
-        below = self._tracks[named.track_id].below_since
-        return t - below >= self.params.doubt_s - STAMP_EPS
+        ev = self._tracks[named.track_id]
+        if ev.last_match < ev.unlike_since < math.inf:
+            return True  # clothes clearly unlike hers, no face of hers since: slid off her
+        return t - ev.below_since >= self.params.doubt_s - STAMP_EPS
 
     def _confirmed(self, ev: _Evidence, t: float) -> bool:
         """Whether a track at TARGET without a face has been so long enough to be named:
