@@ -783,19 +783,19 @@ class TargetIdentifier:
     def _note_two_in_her_clothes(
         self, t: float, tracks: Sequence[tuple[int, float, float, bool]]
     ) -> None:
-        """Two detected people in her clothes at least ``coexist_distance`` apart at once: one
+        """Two people in her clothes at least ``coexist_distance`` apart at once: one
         of them at most is her, so a look-alike is about — remembered for
         ``look_alike_memory_s``, as a look-alike rejected by face is, so that when one of the two
         is lost the other is not named on her clothes alone (item 2). Only people whose clothes
-        were measured within :data:`FRESH_CLOTHES_S` count (a track's old samples may be of
-        someone else); a person the camera sees and the laser does not (yet) counts too: at
-        worst her clothes are no evidence for a while, which loses her rather than following
-        someone else."""
+        the camera measured within :data:`FRESH_CLOTHES_S` count (a track's old samples may be
+        of someone else), whether the laser sees them or not (a track the camera alone sees
+        coasts between the laser's scans): at worst her clothes are no evidence for a while,
+        which loses her rather than following someone else."""
         p = self.params
         dressed: list[tuple[float, float]] = []
-        for tid, x, y, detected in tracks:
+        for tid, x, y, _ in tracks:
             ev = self._tracks.get(tid)
-            if not detected or ev is None:
+            if ev is None:
                 continue
             clothes = ev.clothes_now(p.clothes_recent)
             if (

@@ -484,9 +484,9 @@ def test_a_face_too_small_to_tell_is_no_evidence_either_way(learned) -> None:
 def test_two_people_in_her_clothes_apart_at_once_leave_her_clothes_no_evidence() -> None:
     """No faces: tracks 1 and 2 both in her clothes, 3 m apart at once, so one of them at most
     is her. When track 1 is lost, track 2 alone is not named on clothes (a look-alike is about,
-    remembered), also when the laser had not seen track 2's legs yet; two tracks in her clothes
-    0.5 m apart (the tracker split one person) are no such evidence, and the one left is
-    named."""
+    remembered), also when only the camera sees track 2 (no legs, coasting between scans); two
+    tracks in her clothes 0.5 m apart (the tracker split one person) are no such evidence, and
+    the one left is named."""
     params = IdentityParams(faces=False, confirm_frames=5, confirm_s=0.5)
     img, det = _shirt((80, 150), (RED,))
     profile = learn_profile([describe(img, det, params)], params)
@@ -494,7 +494,7 @@ def test_two_people_in_her_clothes_apart_at_once_leave_her_clothes_no_evidence()
         ident = TargetIdentifier(profile, params)
         for k in range(10):
             t = 0.1 * k
-            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, gap, True)])
+            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, gap, legs)])
             ident.observe(1, t, True, replace(det, position=(2.0, 0.0, 1.0)), img)
             ident.observe(2, t, legs, replace(det, position=(2.0, gap, 1.0)), img)
             assert ident.target_track() is None, (gap, t)  # each sees the other in her clothes
