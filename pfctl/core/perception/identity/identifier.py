@@ -47,8 +47,9 @@ benchmarks/bench_identity.py measures it). The decision is the median S of the n
 ``clothes_recent`` samples, so a track the tracker slid onto someone else shows it within a few
 samples, and one odd sample (an arm across the shirt) does not; a track whose median comes back
 within the margin of the threshold is measured on every frame again, and so is the named track's.
-A track whose clothes turn clearly unlike hers after her face was seen on it has slid onto
-someone else: its faces are forgotten and it loses the name at once.
+A track whose clothes turn clearly unlike hers has slid onto someone else: the faces of hers it
+showed before are forgotten (they are not this person's), and if named it loses the name at
+once.
 
 The face search itself (dlib's HOG detector and ResNet embedding, far more than a tick's budget
 per face; benchmarks/bench_identity.py) runs inline by default, or — given a
@@ -610,9 +611,9 @@ class TargetIdentifier:
 
     def _check_unlike(self, ev: _Evidence, clothes: float | None, now: float) -> None:
         """A track whose clothes turn clearly unlike hers (``clothes_margin`` below the
-        threshold) after her face was seen on it has slid onto someone else (the tracker
-        swapped it in a crowd): the faces it showed before were another person's, so they are
-        forgotten, and a name it holds goes at once (:meth:`_doubted`)."""
+        threshold) has slid onto someone else (the tracker swapped it in a crowd): the faces of
+        hers it showed before are not this person's, so they are forgotten, and a name it holds
+        goes at once unless her face is seen on it again (:meth:`_doubted`)."""
         p = self.params
         unlike = clothes is not None and clothes < p.clothes_similarity - p.clothes_margin
         if not unlike:
