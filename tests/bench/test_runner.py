@@ -20,7 +20,7 @@ import pytest
 from pfctl.bench.plan import EpisodeSpec
 from pfctl.core.perception.face_worker import FaceWorker
 from tests.conftest import HOUSE_MISSION
-from tests.processes import process_gone
+from tests.processes import process_gone, processes_end
 
 pytestmark = [pytest.mark.slow]
 
@@ -203,7 +203,7 @@ def test_signals_keep_what_finished_and_leave_no_process(
     assert "Traceback" not in err and "Error" not in err
     assert [r["seed"] for r in _records(out)] == [1]
     assert "1/3 episodes" in (out / "summary.md").read_text()
-    assert all(process_gone(pid) for pid in pids), pids
+    assert processes_end(pids), [pid for pid in pids if not process_gone(pid)]
 
 
 def test_ctrl_c_while_workers_start_prints_no_traceback(tmp_path: Path) -> None:
