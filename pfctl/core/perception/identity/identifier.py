@@ -557,11 +557,11 @@ class TargetIdentifier:
 
     def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
         p = self.params
-        self._check_unlike(ev, ev.clothes_now(p.clothes_recent), ev.last_seen)
-        face_d = ev.face(p.face_recent)
-        best = min(ev.face_distances) if ev.face_distances else None
         clothes = ev.clothes_now(p.clothes_recent)
         now = ev.last_seen
+        self._check_unlike(ev, clothes, now)  # before the faces: it may forget them
+        face_d = ev.face(p.face_recent)
+        best = min(ev.face_distances) if ev.face_distances else None
         if face_d is not None and face_d >= p.face_distance:
             self._rejected_by_face(track_id, ev, clothes, now)
         elif face_d is not None and track_id in self.distractors.people:
