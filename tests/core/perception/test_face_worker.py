@@ -28,7 +28,7 @@ from pfctl.core.perception.identity.profile import (
     learn_profile,
 )
 from pfctl.core.perception.vision import PersonDetection
-from tests.processes import process_gone
+from tests.processes import process_gone, processes_end
 
 ROOT = Path(__file__).resolve().parents[3]
 RED, NAVY, GREY = (200, 30, 40), (40, 40, 120), (90, 90, 90)
@@ -44,15 +44,6 @@ def worker() -> Iterator[FaceWorker]:
     with FaceWorker(FaceParams()) as w:
         w.wait_ready(LOADING_S)
         yield w
-
-
-def _wait_gone(pid: int, limit: float = 20.0) -> bool:
-    deadline = time.monotonic() + limit
-    while time.monotonic() < deadline:
-        if process_gone(pid):
-            return True
-        time.sleep(0.05)
-    return False
 
 
 # -- the worker -----------------------------------------------------------------------------------
@@ -196,7 +187,7 @@ def test_the_child_ends_with_its_parent(ending: str) -> None:
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=LOADING_S, cwd=ROOT
     )
     assert done.returncode == (0 if ending == "exit" else -signal.SIGKILL), done.stderr
-    assert _wait_gone(int(done.stdout.split()[0]))
+    assert processes_end([int(done.stdout.split()[0])], 20.0)
     assert done.stderr == ""
 
 
