@@ -173,6 +173,7 @@ def run_episode(
         face_worker=use_worker,
         face_timing=face_timing,
         robot=kind,
+        handoff=not until_found,
     )
     try:
         identifier = perception.identifier

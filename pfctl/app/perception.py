@@ -7,6 +7,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Literal
 
@@ -78,6 +79,7 @@ def build_perception(
     face_worker: bool | FaceWorker = False,
     face_timing: FaceTiming | None = None,
     robot: Literal["sim", "real"] = "sim",
+    handoff: bool = True,
 ) -> Perception:
     """The mission's perception: its leg model (``leg_model`` overrides
     ``perception.legs.model``; neither: the shipped model), tracker, and — when given — a
@@ -89,12 +91,16 @@ def build_perception(
     searches faces inline. Its timing is ``face_timing``, else the mission's for ``robot``; with
     ``realtime`` timing the worker runs at the lowest priority (nice 19, ``SCHED_IDLE``), with
     ``deterministic`` at the normal one (the loop waits for it). The perception then owns the
-    worker: :meth:`Perception.close` stops it.
+    worker: :meth:`Perception.close` stops it. ``handoff`` False: no one is handed off at
+    the start (``perception.identity.handoff_s``; for ``pfctl search``, where she was never
+    shown to the robot).
     """
     model = load_leg_model(leg_model or mission.perception.legs.model)
     identifier = None
     if profile is not None:
         params = identity_params(mission, robot, face_timing)
+        if not handoff:
+            params = replace(params, handoff_s=0.0)
         check_target_profile(profile, params)
         worker: FaceWorker | None = None
         if isinstance(face_worker, FaceWorker):

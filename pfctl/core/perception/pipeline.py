@@ -52,7 +52,7 @@ from pfctl.core.perception.tracking import (
     Track,
     TrackStatus,
 )
-from pfctl.core.perception.vision import PersonDetection, PersonDetector
+from pfctl.core.perception.vision import PersonDetection, PersonDetector, horizontal_range
 from pfctl.core.robot import LaserScan, Observation, RgbdFrame
 
 #: A lone leg this close to a person the camera sees is that person's, metres.
@@ -145,7 +145,13 @@ class Perception:
                 for person, track_id in zip(people, ids, strict=True)
                 if track_id is not None
             ]
-            found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen)
+            handoff = self.identifier.params.handoff_range
+            near = [
+                track_id
+                for track_id, legs, person in seen
+                if legs and horizontal_range(frame, person) <= handoff
+            ]
+            found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen, near=near)
             identities = {s[0]: identity for s, identity in zip(seen, found, strict=True)}
         sightings = [
             CameraSighting(person, track_id, None if track_id is None else identities.get(track_id))

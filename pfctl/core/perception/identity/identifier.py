@@ -75,7 +75,7 @@ import enum
 import itertools
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -289,6 +289,10 @@ class TargetIdentifier:
         """The people found not to be her (issue 23, item 4)."""
         self._named: int | None = None
         """The track named the target (switched only on confirmation, :meth:`target_track`)."""
+        self._named_once = False
+        """Whether anyone was ever named (the hand-off is only for the start of a run)."""
+        self._first_frame = math.inf
+        """The stamp of the first camera frame (the hand-off's window starts there)."""
         self._look_alike_at = -math.inf
         """When a person in her clothes was last found not to be her (by face, or seen beside
         her, or linked to someone who was)."""
@@ -336,12 +340,16 @@ class TargetIdentifier:
         t: float,
         rgb: np.ndarray | None,
         sightings: Sequence[tuple[int, bool, PersonDetection | None]],
+        *,
+        near: Collection[int] = (),
     ) -> list[TrackIdentity]:
         """Add one observation per ``(track_id, has_legs, detection)`` of the frame ``rgb``
         stamped ``t`` (detection None: the camera did not see that track); the updated
         identities, in order. Face searches that are due go to the tracks searched longest ago
-        first (they matter when a worker has few slots)."""
+        first (they matter when a worker has few slots). ``near``: the tracks this frame sees
+        within ``handoff_range`` of the camera (:meth:`_hand_off`)."""
         self.update(t)
+        self._first_frame = min(self._first_frame, t)
         seen: list[tuple[int, _Evidence, PersonDetection | None]] = []
         for track_id, has_legs, detection in sightings:
             seen.append((track_id, self._observed(track_id, t, has_legs, detection), None))
@@ -371,6 +379,7 @@ class TargetIdentifier:
                 region = face_region(detection, rgb.shape)
                 if region is not None:
                     self._search(track_id, ev, t, rgb, region)
+        self._hand_off(t, near)
         identities = [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
         self._name(t)
         return identities
@@ -682,6 +691,32 @@ class TargetIdentifier:
             if best is None or key > best[0]:
                 best = (key, tid)
         self._named = None if best is None else best[1]
+        self._named_once |= self._named is not None
+
+    def _hand_off(self, t: float, near: Collection[int]) -> None:
+        """The start of following (item 2's one exception): within ``handoff_s`` of the first
+        frame and before anyone was named, the one person seen within ``handoff_range`` of the
+        camera — legs tracked, clothes matching hers, no face of someone else, not known to be
+        someone else — is the person the robot was just shown (``pfctl learn-target``, then
+        ``pfctl follow``), and is named at once, look-alikes about or not. From then on her
+        track keeps the name on continuity, as any named track does: she can be followed from
+        behind among look-alikes. Two people that close make it ambiguous, and the usual rules
+        name her (a face, or a confirmed identification)."""
+        p = self.params
+        late = t - self._first_frame > p.handoff_s + STAMP_EPS
+        if p.handoff_s <= 0 or self._named_once or late or len(near) != 1:
+            return
+        (track_id,) = near
+        ev = self._tracks.get(track_id)
+        if ev is None or not ev.legs_seen or ev.distractor is not None:
+            return
+        clothes = ev.clothes_now(p.clothes_recent)
+        face = ev.face(p.face_recent)
+        if clothes is None or clothes < p.clothes_similarity:
+            return
+        if face is not None and face >= p.face_distance:
+            return
+        self._named, self._named_once = track_id, True
 
     def _doubted(self, named: TrackIdentity, t: float) -> bool:
         """Whether the named track has lost the name: decided NOT_TARGET; its clothes clearly

@@ -549,3 +549,47 @@ def test_a_named_track_in_doubt_loses_the_name_after_doubt_s() -> None:
     below = named.index(None)
     # the median of the newest 5 turns at the third such sample; then doubt_s (1 s) passes
     assert 12 <= below <= 14 and named[below:] == [None] * (len(named) - below)
+
+
+def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(learned) -> None:
+    """At the start, her back 1.5 m from the camera (the one person that close) and a look-alike
+    4 m away: she is named at once and keeps the name on continuity through 5 s of back views.
+    No hand-off when the look-alike is that close too, with ``handoff_s`` 0 (``pfctl search``),
+    after ``handoff_s``, or once someone was named: then she is not named (only a face could
+    tell them apart)."""
+    profile, params, encoder = learned
+    her, other = _picture(RED, None), _picture(RED, None)
+    rgb = np.hstack([her[0], other[0]])  # one frame, her on the left, the look-alike beside
+    beside = replace(other[1], box=(190, 4, 290, 236), head_box=(210, 4, 270, 76))
+
+    def frame(ident: TargetIdentifier, t: float, near: list[int], tracks=(1, 2)) -> None:
+        where = {1: (1.5, 0.0), 2: (4.0, 1.0), 3: (1.5, 0.5)}
+        ident.note_tracks(t, [(k, *where[k], True) for k in tracks])
+        seen = [
+            (k, True, replace(beside if k == 2 else her[1], position=(*where[k], 1.0)))
+            for k in tracks
+        ]
+        ident.observe_frame(t, rgb, seen, near=near)
+
+    def run(settings: IdentityParams, near: list[int]) -> list[int | None]:
+        ident = TargetIdentifier(profile, settings, encoder)
+        named = []
+        for k in range(50):
+            frame(ident, 0.1 * k, near)
+            named.append(ident.target_track())
+        return named
+
+    assert run(params, [1]) == [1] * 50
+    assert run(params, [1, 2]) == [None] * 50  # ambiguous: both within handoff_range
+    assert run(params, []) == [None] * 50
+    assert run(replace(params, handoff_s=0.0), [1]) == [None] * 50
+    ident = TargetIdentifier(profile, params, encoder)
+    frame(ident, 0.0, [], tracks=(2,))
+    frame(ident, params.handoff_s + 0.1, [1])
+    assert ident.target_track() is None  # too late after the first frame
+    ident = TargetIdentifier(profile, params, encoder)
+    frame(ident, 0.0, [1])
+    assert ident.target_track() == 1
+    ident.forget(1)  # lost at once; someone in her clothes close again: not the start any more
+    frame(ident, 0.5, [3], tracks=(2, 3))
+    assert ident.target_track() is None
