@@ -293,6 +293,14 @@ class TargetIdentifier:
         """Whether anyone was ever named (the hand-off is only for the start of a run)."""
         self._first_frame = math.inf
         """The stamp of the first camera frame (the hand-off's window starts there)."""
+        self._last_frame = -math.inf
+        """The stamp of the newest camera frame observed."""
+        self._apart: set[int] = set()
+        """Tracks seen at least ``coexist_distance`` from the named track since it was named
+        (other people, not a split of her track): one of them coming close may be swapped with
+        her (:meth:`_note_crossing`)."""
+        self._apart_of: int | None = None
+        """The named track ``_apart`` is about."""
         self._look_alike_at = -math.inf
         """When a person in her clothes was last found not to be her (by face, or seen beside
         her, or linked to someone who was)."""
@@ -326,6 +334,7 @@ class TargetIdentifier:
         is then searched only when due)."""
         if appearance is not None and detection is not None:
             self.update(t)
+            self._last_frame = max(self._last_frame, t)
             ev = self._observed(track_id, t, has_legs, detection)
             self._add_clothes(ev, appearance, t)
             if appearance.face is not None and self.searches_faces:
@@ -350,6 +359,7 @@ class TargetIdentifier:
         within ``handoff_range`` of the camera (:meth:`_hand_off`)."""
         self.update(t)
         self._first_frame = min(self._first_frame, t)
+        self._last_frame = max(self._last_frame, t)
         seen: list[tuple[int, _Evidence, PersonDetection | None]] = []
         for track_id, has_legs, detection in sightings:
             seen.append((track_id, self._observed(track_id, t, has_legs, detection), None))
@@ -797,6 +807,7 @@ class TargetIdentifier:
             )
         }
         self._note_two_in_her_clothes(t, tracks)
+        self._note_crossing(xy)
         her = self._named
         ev = self._tracks.get(her) if her is not None else None
         if her is None or ev is None or her not in xy:
@@ -815,6 +826,52 @@ class TargetIdentifier:
                 other.distractor = "coexisted"
             if other.distractor is not None:
                 self.distractors.remember(tid, (x, y), t, "coexisted", other.upper, other.lower)
+
+    def _note_crossing(self, xy: dict[int, tuple[float, float]]) -> None:
+        """Another person comes within ``swap_distance`` of her named track — someone tracked
+        at least ``coexist_distance`` from it before, not a split of her own track — where the
+        camera cannot tell the two apart: the other is in her clothes, or her track was not in
+        the camera's last frame. The tracker may swap two people as they cross (traced: a
+        look-alike crossing her, and her track coasting out of view onto a passer-by's legs),
+        so which track is her is not known any more: the name goes (she is lost rather than
+        someone else followed), and both tracks forget the faces and the run of
+        identifications they had (they may be the other person's). A face, or a confirmed
+        identification, names her again."""
+        her = self._named
+        if her != self._apart_of:
+            self._apart, self._apart_of = set(), her
+        if her is None or her not in xy:
+            return
+        p = self.params
+        ev = self._tracks.get(her)
+        unseen = ev is None or ev.last_seen < self._last_frame - STAMP_EPS
+        hx, hy = xy[her]
+        for tid, (x, y) in xy.items():
+            gap = math.hypot(x - hx, y - hy)
+            if tid == her or gap >= p.coexist_distance:
+                self._apart.add(tid)
+                continue
+            if gap >= p.swap_distance or tid not in self._apart:
+                continue
+            other = self._tracks.get(tid)
+            clothes = None if other is None else other.clothes_now(p.clothes_recent)
+            if unseen or (clothes is not None and clothes >= p.clothes_similarity):
+                self._named = None
+                for track_id in (her, tid):
+                    self._forget_who(track_id)
+                return
+
+    def _forget_who(self, track_id: int) -> None:
+        """Forget what said who a track is: its faces and its run of identifications (the
+        tracker may have swapped it onto someone else, :meth:`_note_crossing`)."""
+        ev = self._tracks.get(track_id)
+        if ev is None:
+            return
+        ev.face_distances.clear()
+        ev.last_match = ev.last_face = -math.inf
+        ev.streak, ev.streak_since = 0, math.inf
+        if track_id in self._latest:
+            self._latest[track_id] = self._decide(track_id, ev, None)
 
     def _note_two_in_her_clothes(
         self, t: float, tracks: Sequence[tuple[int, float, float, bool]]

@@ -144,6 +144,14 @@ class IdentityParams:
         unit="m",
         gt=0,
     )
+    swap_distance: float = param(
+        0.6,
+        "Another person this close to her named track, where the camera cannot tell them apart"
+        " (in her clothes, or her track out of the camera's view), may have been swapped with"
+        " her by the tracker: the name goes.",
+        unit="m",
+        gt=0,
+    )
     update_clearance: float = param(
         1.0,
         "Her appearance model learns from a frame only when no other person is this close.",

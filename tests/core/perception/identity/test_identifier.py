@@ -593,3 +593,50 @@ def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(
     ident.forget(1)  # lost at once; someone in her clothes close again: not the start any more
     frame(ident, 0.5, [3], tracks=(2, 3))
     assert ident.target_track() is None
+
+
+def test_a_look_alike_crossing_her_named_track_takes_the_name_away(learned) -> None:
+    """Her face names track 1. A look-alike (her clothes, back only) walks up from 3 m away:
+    within ``swap_distance`` the tracker may swap the two, so the name goes, and her face on
+    track 1 is forgotten; after they part neither is named on clothes. A second track of
+    her own that appears beside her (the tracker split her: never apart from her) leaves the
+    name alone."""
+    profile, params, encoder = learned
+    her, back = _picture(RED, TARGET_FACE), _picture(RED, None)
+    for other_start, named_after in ((3.05, None), (0.3, 1)):
+        ident = TargetIdentifier(profile, params, encoder)
+        named = []
+        for k in range(40):
+            t = 0.1 * k
+            y2 = max(other_start - 0.1 * k, 0.3) if k < 30 else 0.3 + 0.2 * (k - 29)
+            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, y2, True)])
+            ident.observe(1, t, True, *_at(her if k < 3 else back, 2.0, 0.0))
+            ident.observe(2, t, True, *_at(back, 2.0, y2))
+            named.append(ident.target_track())
+        assert named[3] == 1 and named[-1] == named_after, other_start
+        if named_after is None:
+            assert named.index(None, 3) == 25  # 0.55 m apart: within 0.6 m
+            assert ident.identity(1).face_samples == 0
+
+
+def test_a_passer_by_beside_her_track_out_of_view_takes_the_name_away() -> None:
+    """No faces, no look-alike: track 1 named on her clothes; a person in green walks up from
+    3 m to 0.4 m of it. While the camera sees track 1 (its clothes tell them apart) the name
+    stays; while it does not (her track coasts out of view) the name goes, and comes back once
+    the camera sees her clothes on track 1 again for ``confirm_s``."""
+    params = IdentityParams(faces=False, confirm_frames=3, confirm_s=0.5)
+    red, green = _shirt((80, 150), (RED,)), _shirt((80, 150), (GREEN,))
+    profile = learn_profile([describe(*red, params)], params)
+    for in_view, named_during in ((True, 1), (False, None)):
+        ident = TargetIdentifier(profile, params)
+        named = []
+        for k in range(60):
+            t = 0.1 * k
+            y2 = max(3.0 - 0.2 * k, 0.4)
+            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, y2, True)])
+            if k < 10 or k >= 40 or in_view:
+                ident.observe(1, t, True, replace(red[1], position=(2.0, 0.0, 1.0)), red[0])
+            ident.observe(2, t, True, replace(green[1], position=(2.0, y2, 1.0)), green[0])
+            named.append(ident.target_track())
+        assert named[9] == 1 and named[30] == named_during, in_view
+        assert named[-1] == 1
