@@ -30,6 +30,7 @@ confirmation), as long as the tracker still has it.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -52,7 +53,7 @@ from pfctl.core.perception.tracking import (
     Track,
     TrackStatus,
 )
-from pfctl.core.perception.vision import PersonDetection, PersonDetector, horizontal_range
+from pfctl.core.perception.vision import PersonDetection, PersonDetector
 from pfctl.core.robot import LaserScan, Observation, RgbdFrame
 
 #: A lone leg this close to a person the camera sees is that person's, metres.
@@ -145,11 +146,13 @@ class Perception:
                 for person, track_id in zip(people, ids, strict=True)
                 if track_id is not None
             ]
-            handoff = self.identifier.params.handoff_range
+            # everyone the tracker has near the camera, seen by it or not (hidden behind another)
+            cx, cy, _ = frame.camera_position
+            reach = self.identifier.params.handoff_range
             near = [
-                track_id
-                for track_id, legs, person in seen
-                if legs and horizontal_range(frame, person) <= handoff
+                t.id
+                for t in self.tracker.tracks(confirmed_only=True)
+                if math.hypot(t.x - cx, t.y - cy) <= reach
             ]
             found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen, near=near)
             identities = {s[0]: identity for s, identity in zip(seen, found, strict=True)}

@@ -293,12 +293,15 @@ class TargetIdentifier:
         """Whether anyone was ever named (the hand-off is only for the start of a run)."""
         self._first_frame = math.inf
         """The stamp of the first camera frame (the hand-off's window starts there)."""
+        self._near_seen: set[int] = set()
+        """The tracks seen within ``handoff_range`` since the first frame (:meth:`_hand_off`)."""
         self._last_frame = -math.inf
         """The stamp of the newest camera frame observed."""
         self._apart: set[int] = set()
-        """Tracks seen at least ``coexist_distance`` from the named track since it was named
-        (other people, not a split of her track): one of them coming close may be swapped with
-        her (:meth:`_note_crossing`)."""
+        """Tracks known to be other people than the named track since it was named — tracked
+        at least ``coexist_distance`` from it, or seen by the camera beside it in one frame
+        (not a split of her track): one of them coming close may be swapped with her
+        (:meth:`_note_crossing`)."""
         self._apart_of: int | None = None
         """The named track ``_apart`` is about."""
         self._look_alike_at = -math.inf
@@ -355,8 +358,8 @@ class TargetIdentifier:
         """Add one observation per ``(track_id, has_legs, detection)`` of the frame ``rgb``
         stamped ``t`` (detection None: the camera did not see that track); the updated
         identities, in order. Face searches that are due go to the tracks searched longest ago
-        first (they matter when a worker has few slots). ``near``: the tracks this frame sees
-        within ``handoff_range`` of the camera (:meth:`_hand_off`)."""
+        first (they matter when a worker has few slots). ``near``: the tracks within
+        ``handoff_range`` of the camera now, seen by it or hidden (:meth:`_hand_off`)."""
         self.update(t)
         self._first_frame = min(self._first_frame, t)
         self._last_frame = max(self._last_frame, t)
@@ -390,6 +393,10 @@ class TargetIdentifier:
                 if region is not None:
                     self._search(track_id, ev, t, rgb, region)
         self._hand_off(t, near)
+        if self._named is not None and self._named == self._apart_of:
+            ids = {track_id for track_id, _, detection in seen if detection is not None}
+            if self._named in ids:  # people the camera sees beside her at once are others
+                self._apart |= ids - {self._named}
         identities = [self._identify(track_id, ev, t) for track_id, ev, _ in seen]
         self._name(t)
         return identities
@@ -705,20 +712,24 @@ class TargetIdentifier:
 
     def _hand_off(self, t: float, near: Collection[int]) -> None:
         """The start of following (item 2's one exception): within ``handoff_s`` of the first
-        frame and before anyone was named, the one person seen within ``handoff_range`` of the
-        camera — legs tracked, clothes matching hers, no face of someone else, not known to be
-        someone else — is the person the robot was just shown (``pfctl learn-target``, then
-        ``pfctl follow``), and is named at once, look-alikes about or not. From then on her
-        track keeps the name on continuity, as any named track does: she can be followed from
-        behind among look-alikes. Two people that close make it ambiguous, and the usual rules
-        name her (a face, or a confirmed identification)."""
+        frame and before anyone was named, the one person tracked within ``handoff_range`` of
+        the camera, seen by it now — legs tracked, clothes matching hers, no face of someone
+        else, not known to be someone else — is the person the robot was just shown (``pfctl
+        learn-target``, then ``pfctl follow``), and is named at once, look-alikes about or not.
+        From then on her track keeps the name on continuity, as any named track does: she can
+        be followed from behind among look-alikes. A second person tracked that close at any
+        time in the window (seen, or hidden behind another) makes it ambiguous: no hand-off,
+        and the usual rules name her (a face, or a confirmed identification)."""
         p = self.params
         late = t - self._first_frame > p.handoff_s + STAMP_EPS
-        if p.handoff_s <= 0 or self._named_once or late or len(near) != 1:
+        if p.handoff_s <= 0 or self._named_once or late:
+            return
+        self._near_seen.update(near)
+        if len(self._near_seen) != 1 or len(near) != 1:
             return
         (track_id,) = near
         ev = self._tracks.get(track_id)
-        if ev is None or not ev.legs_seen or ev.distractor is not None:
+        if ev is None or ev.last_seen != t or not ev.legs_seen or ev.distractor is not None:
             return
         clothes = ev.clothes_now(p.clothes_recent)
         face = ev.face(p.face_recent)
@@ -829,14 +840,14 @@ class TargetIdentifier:
 
     def _note_crossing(self, xy: dict[int, tuple[float, float]]) -> None:
         """Another person comes within ``swap_distance`` of her named track — someone tracked
-        at least ``coexist_distance`` from it before, not a split of her own track — where the
-        camera cannot tell the two apart: the other is in her clothes, or her track was not in
-        the camera's last frame. The tracker may swap two people as they cross (traced: a
-        look-alike crossing her, and her track coasting out of view onto a passer-by's legs),
-        so which track is her is not known any more: the name goes (she is lost rather than
-        someone else followed), and both tracks forget the faces and the run of
-        identifications they had (they may be the other person's). A face, or a confirmed
-        identification, names her again."""
+        at least ``coexist_distance`` from it or seen by the camera beside it before, not a
+        split of her own track — where the camera cannot tell the two apart: the other is in
+        her clothes, or her track was not in the camera's last frame. The tracker may swap two
+        people as they cross (traced: a look-alike crossing her, and her track coasting out of
+        view onto a passer-by's legs), so which track is her is not known any more: the name
+        goes (she is lost rather than someone else followed), and both tracks forget the faces
+        and the run of identifications they had (they may be the other person's). A face, or a
+        confirmed identification, names her again."""
         her = self._named
         if her != self._apart_of:
             self._apart, self._apart_of = set(), her

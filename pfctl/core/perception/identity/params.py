@@ -110,16 +110,17 @@ class IdentityParams:
     handoff_s: float = param(
         3.0,
         "Hand-off at the start of a run: within this long of the first frame, the one person"
-        " the camera sees within ``handoff_range`` (legs tracked, in her clothes, no face of"
-        " someone else) is the person the robot was just shown, and is named at once, look-alikes"
-        " about or not (0: never; ``pfctl search``, where she was never shown, does not hand off).",
+        " tracked within ``handoff_range`` of the camera (seen by it, legs tracked, in her"
+        " clothes, no face of someone else) is the person the robot was just shown, and is named"
+        " at once, look-alikes about or not (0: never; ``pfctl search``, where she was never"
+        " shown, does not hand off).",
         unit="s",
         ge=0,
     )
     handoff_range: float = param(
         2.5,
         "... the distance from the camera within which she stands to be handed off; a second"
-        " person that close makes the hand-off ambiguous, and it is not made.",
+        " person tracked that close at any time in the window makes it ambiguous: no hand-off.",
         unit="m",
         gt=0,
     )

@@ -554,9 +554,9 @@ def test_a_named_track_in_doubt_loses_the_name_after_doubt_s() -> None:
 def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(learned) -> None:
     """At the start, her back 1.5 m from the camera (the one person that close) and a look-alike
     4 m away: she is named at once and keeps the name on continuity through 5 s of back views.
-    No hand-off when the look-alike is that close too, with ``handoff_s`` 0 (``pfctl search``),
-    after ``handoff_s``, or once someone was named: then she is not named (only a face could
-    tell them apart)."""
+    No hand-off when the look-alike is that close too (now, or in an earlier frame), with
+    ``handoff_s`` 0 (``pfctl search``), after ``handoff_s``, or once someone was named: then
+    she is not named (only a face could tell them apart)."""
     profile, params, encoder = learned
     her, other = _picture(RED, None), _picture(RED, None)
     rgb = np.hstack([her[0], other[0]])  # one frame, her on the left, the look-alike beside
@@ -581,6 +581,11 @@ def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(
 
     assert run(params, [1]) == [1] * 50
     assert run(params, [1, 2]) == [None] * 50  # ambiguous: both within handoff_range
+    ident = TargetIdentifier(profile, params, encoder)
+    frame(ident, 0.0, [1, 2])  # the look-alike was that close once: ambiguous for the window
+    for k in range(1, 20):
+        frame(ident, 0.1 * k, [1])
+    assert ident.target_track() is None
     assert run(params, []) == [None] * 50
     assert run(replace(params, handoff_s=0.0), [1]) == [None] * 50
     ident = TargetIdentifier(profile, params, encoder)
@@ -640,3 +645,29 @@ def test_a_passer_by_beside_her_track_out_of_view_takes_the_name_away() -> None:
             named.append(ident.target_track())
         assert named[9] == 1 and named[30] == named_during, in_view
         assert named[-1] == 1
+
+
+def test_a_look_alike_the_camera_saw_beside_her_counts_as_someone_else_when_close(learned) -> None:
+    """A look-alike walks 0.8 m beside her (never 1 m apart, so not known to be someone else by
+    distance), both in the camera's frames; when he comes within ``swap_distance`` the name
+    goes. Seen only in frames of their own (as a split of her track would be), it stays."""
+    profile, params, encoder = learned
+    her, back = _picture(RED, TARGET_FACE), _picture(RED, None)
+    beside = replace(back[1], box=(190, 4, 290, 236), head_box=(210, 4, 270, 76))
+    for together, named_after in ((True, None), (False, 1)):
+        ident = TargetIdentifier(profile, params, encoder)
+        for k in range(30):
+            t = 0.1 * k
+            y2 = 0.8 if k < 20 else 0.4
+            rgb = np.hstack([(her if k < 3 else back)[0], back[0]])
+            ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, y2, True)])
+            mine = (1, True, replace(her[1], position=(2.0, 0.0, 1.0)))
+            his = (2, True, replace(beside, position=(2.0, y2, 1.0)))
+            if together:
+                ident.observe_frame(t, rgb, [mine, his])
+            else:
+                ident.observe_frame(t, rgb, [mine])
+                ident.observe_frame(t + 0.05, rgb, [his])
+            if k == 19:
+                assert ident.target_track() == 1
+        assert ident.target_track() == named_after, together
