@@ -15,20 +15,23 @@ the same way. When a track has seen faces both ways (a bad detection, or a track
 swapped onto someone else), the median of its newest ``face_recent`` face distances decides.
 
 **Who is the target** is a name, not a choice made again each frame (issue 23): the named track
-stays the target while the tracker holds it and it is not decided NOT_TARGET nor below TARGET
-for ``doubt_s`` (a face that does not quite match, clothes that stopped matching: she is lost
-rather than followed on doubt) — unless another track shows her face more recently by
-``face_recheck_s`` (the named one was swapped). A new
-track is named at once on a face match, else only after ``confirm_frames`` identifications in a
-row at TARGET over ``confirm_s`` at least (time to go and see the face); while a look-alike is
-about, clothes are no evidence, so only a face names anyone and otherwise she is lost. A
-look-alike is about while another track matches her clothes, and for ``look_alike_memory_s``
-after a person in her clothes was rejected by face, marked a distractor, or tracked at least
-``coexist_distance`` from another person in her clothes at once (one of the two at most is
-her). People
-found not to be her are remembered (:mod:`~pfctl.core.perception.identity.distractors`):
-rejected by face, or seen at the same time as her face-confirmed track away from her
-(:meth:`TargetIdentifier.note_tracks`); a new track where one of them was lost stays rejected.
+stays the target while the tracker holds it and it is not decided NOT_TARGET nor below TARGET for
+``doubt_s`` (a face that does not quite match, clothes that stopped matching: she is lost rather
+than followed on doubt) — unless another track shows her face more recently by ``face_recheck_s``
+(the named one was swapped), and unless another person comes within ``swap_distance`` of it where
+the camera cannot tell the two apart (in her clothes, or her track out of the camera's view: the
+tracker may swap people who cross). A new track is named at once on a face match, else only after
+``confirm_frames`` identifications in a row at TARGET over ``confirm_s`` at least (time to go and
+see the face); while a look-alike is about, clothes are no evidence, so only a face names anyone
+and otherwise she is lost. The one exception is the start of a run, the **hand-off**: the one
+person tracked within ``handoff_range`` of the camera in the first ``handoff_s``, in her clothes,
+is the person the robot was just shown and is named at once. A look-alike is about while another
+track matches her clothes, and for ``look_alike_memory_s`` after a person in her clothes was
+rejected by face, marked a distractor, or tracked at least ``coexist_distance`` from another person
+in her clothes at once (one of the two at most is her). People found not to be her are remembered
+(:mod:`~pfctl.core.perception.identity.distractors`): rejected by face, or seen at the same time as
+her face-confirmed track away from her (:meth:`TargetIdentifier.note_tracks`); a new track where
+one of them was lost stays rejected.
 Her clothes are learned online, only from frames where a face confirms her and no one else is
 within ``update_clearance``. An ambiguous person (her clothes, no face yet) is offered as
 :meth:`TargetIdentifier.candidate_track` for the robot to go and see the face.
@@ -294,7 +297,8 @@ class TargetIdentifier:
         self._first_frame = math.inf
         """The stamp of the first camera frame (the hand-off's window starts there)."""
         self._near_seen: set[int] = set()
-        """The tracks seen within ``handoff_range`` since the first frame (:meth:`_hand_off`)."""
+        """The tracks within ``handoff_range`` of the camera since the first frame
+        (:meth:`_hand_off`)."""
         self._last_frame = -math.inf
         """The stamp of the newest camera frame observed."""
         self._apart: set[int] = set()
@@ -718,26 +722,41 @@ class TargetIdentifier:
         learn-target``, then ``pfctl follow``), and is named at once, look-alikes about or not.
         From then on her track keeps the name on continuity, as any named track does: she can
         be followed from behind among look-alikes. A second person tracked that close at any
-        time in the window (seen, or hidden behind another) makes it ambiguous: no hand-off,
-        and the usual rules name her (a face, or a confirmed identification)."""
+        time in the window (seen, or hidden behind another) who may be her too — not seen yet,
+        or in her clothes — makes it ambiguous: no hand-off, and the usual rules name her (a
+        face, or a confirmed identification). A passer-by in other clothes does not."""
         p = self.params
         late = t - self._first_frame > p.handoff_s + STAMP_EPS
         if p.handoff_s <= 0 or self._named_once or late:
             return
         self._near_seen.update(near)
-        if len(self._near_seen) != 1 or len(near) != 1:
+        seen = [k for k in near if k in self._tracks and self._tracks[k].last_seen == t]
+        hers = [k for k in seen if self._may_be_her(k)]
+        if len(hers) != 1:
             return
-        (track_id,) = near
-        ev = self._tracks.get(track_id)
-        if ev is None or ev.last_seen != t or not ev.legs_seen or ev.distractor is not None:
-            return
+        (track_id,) = hers
+        ev = self._tracks[track_id]
         clothes = ev.clothes_now(p.clothes_recent)
-        face = ev.face(p.face_recent)
-        if clothes is None or clothes < p.clothes_similarity:
+        if not ev.legs_seen or clothes is None or clothes < p.clothes_similarity:
             return
-        if face is not None and face >= p.face_distance:
-            return
+        if any(k != track_id and self._may_be_her(k) for k in self._near_seen):
+            return  # someone else near who may be her too (her clothes, or not seen yet)
         self._named, self._named_once = track_id, True
+
+    def _may_be_her(self, track_id: int) -> bool:
+        """Whether a track may be her as far as the hand-off knows: not known to be someone
+        else (a distractor, a face not hers, clothes measured and not matching hers)."""
+        p = self.params
+        ev = self._tracks.get(track_id)
+        if ev is None:
+            return True  # never seen by the camera, or gone: not known to be anyone else
+        face = ev.face(p.face_recent)
+        clothes = ev.clothes_now(p.clothes_recent)
+        return not (
+            ev.distractor is not None
+            or (face is not None and face >= p.face_distance)
+            or (clothes is not None and clothes < p.clothes_similarity)
+        )
 
     def _doubted(self, named: TrackIdentity, t: float) -> bool:
         """Whether the named track has lost the name: decided NOT_TARGET; its clothes clearly
@@ -859,7 +878,9 @@ class TargetIdentifier:
         hx, hy = xy[her]
         for tid, (x, y) in xy.items():
             gap = math.hypot(x - hx, y - hy)
-            if tid == her or gap >= p.coexist_distance:
+            if tid == her:
+                continue
+            if gap >= p.coexist_distance:
                 self._apart.add(tid)
                 continue
             if gap >= p.swap_distance or tid not in self._apart:

@@ -554,9 +554,10 @@ def test_a_named_track_in_doubt_loses_the_name_after_doubt_s() -> None:
 def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(learned) -> None:
     """At the start, her back 1.5 m from the camera (the one person that close) and a look-alike
     4 m away: she is named at once and keeps the name on continuity through 5 s of back views.
-    No hand-off when the look-alike is that close too (now, or in an earlier frame), with
-    ``handoff_s`` 0 (``pfctl search``), after ``handoff_s``, or once someone was named: then
-    she is not named (only a face could tell them apart)."""
+    A passer-by in other clothes that close does not stop it. No hand-off when the look-alike
+    is that close too (now, or in an earlier frame), with ``handoff_s`` 0 (``pfctl search``),
+    after ``handoff_s``, or once someone was named: then she is not named (only a face could
+    tell them apart)."""
     profile, params, encoder = learned
     her, other = _picture(RED, None), _picture(RED, None)
     rgb = np.hstack([her[0], other[0]])  # one frame, her on the left, the look-alike beside
@@ -581,6 +582,19 @@ def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(
 
     assert run(params, [1]) == [1] * 50
     assert run(params, [1, 2]) == [None] * 50  # ambiguous: both within handoff_range
+    passer = np.hstack([her[0], _picture(GREEN, None)[0]])  # a passer-by in green beside her
+    ident = TargetIdentifier(profile, params, encoder)
+    for k in range(5):
+        ident.observe_frame(
+            0.1 * k,
+            passer,
+            [
+                (1, True, replace(her[1], position=(1.5, 0.0, 1.0))),
+                (4, True, replace(beside, position=(1.5, 0.8, 1.0))),
+            ],
+            near=[1, 4],
+        )
+    assert ident.target_track() == 1  # not in her clothes: no rival
     ident = TargetIdentifier(profile, params, encoder)
     frame(ident, 0.0, [1, 2])  # the look-alike was that close once: ambiguous for the window
     for k in range(1, 20):
