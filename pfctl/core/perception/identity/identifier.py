@@ -102,10 +102,25 @@ STAMP_EPS = 1e-6
 #: are measured every ``clothes_recheck_s``, 0.5 s by default).
 FRESH_CLOTHES_S = 1.0
 
+#: Clothes samples of a person no one else overlapped in the image that show another person than
+#: her for the hand-off (:meth:`TargetIdentifier._may_be_her`).
+CLEAR_SAMPLES = 3
+
 #: Numbers the identifiers, for their job keys.
 _IDENTIFIERS = itertools.count()
 
 # -- per-track decisions -------------------------------------------------------------------------
+
+
+def _overlapped(
+    detection: PersonDetection, sightings: Sequence[tuple[int, bool, PersonDetection | None]]
+) -> bool:
+    """Whether another person's box in the frame overlaps ``detection``'s columns."""
+    x0, _, x1, _ = detection.box
+    return any(
+        other is not None and other is not detection and other.box[0] < x1 and x0 < other.box[2]
+        for _, _, other in sightings
+    )
 
 
 class Decision(enum.Enum):
@@ -184,6 +199,9 @@ class _Evidence:
     for ``doubt_s`` loses the name)."""
     unlike_since: float = math.inf
     """Since when the track's clothes have been clearly unlike hers (inf: they are not)."""
+    clear_clothes: list[float] = field(default_factory=list)
+    """Clothes samples taken while no other person's box overlapped this one's (a person half
+    hidden behind another shows partly the other's clothes)."""
 
     def face(self, recent: int) -> float | None:
         """The median distance of the newest ``recent`` face samples (None: no face yet): a
@@ -382,9 +400,12 @@ class TargetIdentifier:
                     continue
                 if converted is None:
                     converted = convert(rgb, self.params.clothes.color_space)
+                measured = len(ev.clothes)
                 self._add_clothes(ev, describe(rgb, detection, self.params, None, converted), t)
                 ev.last_clothes = t
                 self.face_stats.clothes_measured += 1
+                if len(ev.clothes) > measured and not _overlapped(detection, sightings):
+                    ev.clear_clothes.append(ev.clothes[-1])
             wanted = [
                 (ev.last_search, k)
                 for k, (_, ev, detection) in enumerate(seen)
@@ -745,17 +766,19 @@ class TargetIdentifier:
 
     def _may_be_her(self, track_id: int) -> bool:
         """Whether a track may be her as far as the hand-off knows: not known to be someone
-        else (a distractor, a face not hers, clothes measured and not matching hers)."""
+        else — a distractor, a face not hers, or clothes not hers in the median of at least
+        :data:`CLEAR_SAMPLES` samples taken while no one else overlapped the person in the image
+        (traced, generated home 10: she stood hidden behind a look-alike, and the sliver of her
+        the camera saw did not match her clothes)."""
         p = self.params
         ev = self._tracks.get(track_id)
         if ev is None:
             return True  # never seen by the camera, or gone: not known to be anyone else
         face = ev.face(p.face_recent)
-        clothes = ev.clothes_now(p.clothes_recent)
+        clear = ev.clear_clothes[-p.clothes_recent :]
+        unlike = len(clear) >= CLEAR_SAMPLES and float(np.median(clear)) < p.clothes_similarity
         return not (
-            ev.distractor is not None
-            or (face is not None and face >= p.face_distance)
-            or (clothes is not None and clothes < p.clothes_similarity)
+            ev.distractor is not None or (face is not None and face >= p.face_distance) or unlike
         )
 
     def _doubted(self, named: TrackIdentity, t: float) -> bool:
