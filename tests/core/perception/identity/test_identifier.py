@@ -554,7 +554,8 @@ def test_a_named_track_in_doubt_loses_the_name_after_doubt_s() -> None:
 def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(learned) -> None:
     """At the start, her back 1.5 m from the camera (the one person that close) and a look-alike
     4 m away: she is named at once and keeps the name on continuity through 5 s of back views.
-    A passer-by in other clothes that close does not stop it. No hand-off when the look-alike
+    A passer-by in other clothes that close does not stop it, unless seen only half hidden
+    behind her (his clothes then tell nothing). No hand-off when the look-alike
     is that close too (now, or in an earlier frame), with ``handoff_s`` 0 (``pfctl search``),
     after ``handoff_s``, or once someone was named: then she is not named (only a face could
     tell them apart)."""
@@ -595,6 +596,22 @@ def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(
             near=[1, 4],
         )
     assert ident.target_track() == 1  # not in her clothes: no rival
+    ident = TargetIdentifier(profile, params, encoder)
+    hidden = replace(beside, box=(100, 4, 200, 236))  # half behind her: its clothes mixed
+    for k in range(5):
+        ident.observe_frame(
+            0.1 * k,
+            passer,
+            [
+                (1, True, replace(her[1], position=(1.5, 0.0, 1.0))),
+                (4, True, replace(hidden, position=(2.2, 0.3, 1.0))),
+            ],
+            near=[1, 4],
+        )
+    seen = ident.identity(4)
+    assert seen is not None and seen.clothes_similarity is not None
+    assert seen.clothes_similarity < params.clothes_similarity  # measured unlike her, but
+    assert ident.target_track() is None  # seen only overlapped, he may be her: a rival
     ident = TargetIdentifier(profile, params, encoder)
     frame(ident, 0.0, [1, 2])  # the look-alike was that close once: ambiguous for the window
     for k in range(1, 20):
