@@ -584,30 +584,17 @@ def test_the_person_shown_at_the_start_is_handed_off_and_kept_among_look_alikes(
     assert run(params, [1]) == [1] * 50
     assert run(params, [1, 2]) == [None] * 50  # ambiguous: both within handoff_range
     passer = np.hstack([her[0], _picture(GREEN, None)[0]])  # a passer-by in green beside her
-    ident = TargetIdentifier(profile, params, encoder)
-    for k in range(5):
-        ident.observe_frame(
-            0.1 * k,
-            passer,
-            [
-                (1, True, replace(her[1], position=(1.5, 0.0, 1.0))),
-                (4, True, replace(beside, position=(1.5, 0.8, 1.0))),
-            ],
-            near=[1, 4],
-        )
-    assert ident.target_track() == 1  # not in her clothes: no rival
-    ident = TargetIdentifier(profile, params, encoder)
-    hidden = replace(beside, box=(100, 4, 200, 236))  # half behind her: its clothes mixed
-    for k in range(5):
-        ident.observe_frame(
-            0.1 * k,
-            passer,
-            [
-                (1, True, replace(her[1], position=(1.5, 0.0, 1.0))),
-                (4, True, replace(hidden, position=(2.2, 0.3, 1.0))),
-            ],
-            near=[1, 4],
-        )
+
+    def with_passer(box: tuple[int, int, int, int], at: tuple[float, float]) -> TargetIdentifier:
+        ident = TargetIdentifier(profile, params, encoder)
+        him = replace(beside, box=box, position=(*at, 1.0))
+        for k in range(5):
+            mine = (1, True, replace(her[1], position=(1.5, 0.0, 1.0)))
+            ident.observe_frame(0.1 * k, passer, [mine, (4, True, him)], near=[1, 4])
+        return ident
+
+    assert with_passer(beside.box, (1.5, 0.8)).target_track() == 1  # other clothes: no rival
+    ident = with_passer((100, 4, 200, 236), (2.2, 0.3))  # half behind her: his clothes mixed
     seen = ident.identity(4)
     assert seen is not None and seen.clothes_similarity is not None
     assert seen.clothes_similarity < params.clothes_similarity  # measured unlike her, but
