@@ -102,8 +102,8 @@ STAMP_EPS = 1e-6
 #: are measured every ``clothes_recheck_s``, 0.5 s by default).
 FRESH_CLOTHES_S = 1.0
 
-#: Clothes samples of a person no one else overlapped in the image that show another person than
-#: her for the hand-off (:meth:`TargetIdentifier._may_be_her`).
+#: How many clothes samples unlike hers, taken while no one else overlapped the person in the
+#: image, make them someone other than her for the hand-off (:meth:`TargetIdentifier._may_be_her`).
 CLEAR_SAMPLES = 3
 
 #: Numbers the identifiers, for their job keys.
