@@ -134,12 +134,9 @@ class Perception:
         self._forget_deleted()
         identities: dict[int, TrackIdentity] = {}
         if self.identifier is not None:
+            tracks = self.tracker.tracks()
             self.identifier.note_tracks(
-                frame.stamp,
-                [
-                    (t.id, t.x, t.y, t.status is TrackStatus.CONFIRMED)
-                    for t in self.tracker.tracks()
-                ],
+                frame.stamp, [(t.id, t.x, t.y, t.status is TrackStatus.CONFIRMED) for t in tracks]
             )
             seen = [
                 (track_id, track_id in self._leg_tracks, person)
@@ -151,8 +148,8 @@ class Perception:
             reach = self.identifier.params.handoff_range
             near = [
                 t.id
-                for t in self.tracker.tracks(confirmed_only=True)
-                if math.hypot(t.x - cx, t.y - cy) <= reach
+                for t in tracks
+                if t.status is not TrackStatus.TENTATIVE and math.hypot(t.x - cx, t.y - cy) <= reach
             ]
             found = self.identifier.observe_frame(frame.stamp, frame.rgb, seen, near=near)
             identities = {s[0]: identity for s, identity in zip(seen, found, strict=True)}
