@@ -97,6 +97,7 @@ from pfctl.core.prediction.models import (
     make_model,
 )
 from pfctl.core.robot import STOP, HeadTarget, LaserScan, Observation, Pose2D, Robot
+from pfctl.core.search.gaze import UnseenGaze
 from pfctl.core.search.next_look import doorway
 from pfctl.core.search.whereabouts import Whereabouts
 
@@ -177,6 +178,16 @@ class Follower:
         self.intents = Intents(params.control, self.world, self.navigation)
         self.gaze = GazeController(params.control)
         """The head's PD joint controller (act: one step per head intent)."""
+        self.unseen_gaze = (
+            UnseenGaze(
+                whereabouts,
+                static_map.states() != FREE,
+                params.control.pan_limits,
+            )
+            if params.search.gaze == "unseen"
+            else None
+        )
+        """The search's gaze at the places not seen yet (None: ``search.gaze`` goal)."""
         self.namespace = new_namespace()
         self._writer = py_trees.blackboard.Client(name="follower", namespace=self.namespace)
         for key in KEYS:
@@ -433,6 +444,15 @@ class Follower:
             blocked=belief.blocked if belief is not None else None,
             geometry=belief.geometry if belief is not None else None,
         )
+        if source in ("goal", "none") and self.unseen_gaze is not None:
+            hfov = perception.camera_hfov
+            unseen = (
+                None
+                if hfov is None
+                else self.unseen_gaze.point(self._now, pose, hfov, perception.camera_range)
+            )
+            if unseen is not None:
+                return LookAt(unseen, "unseen")
         if point is None:
             return HeadAngles(0.0, 0.0, source)
         return LookAt(point, source)

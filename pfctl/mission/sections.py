@@ -295,6 +295,7 @@ class SearchConfig(CoreSection, core=SearchParams):
     strategy: FromCore
     never_seen_strategy: FromCore
     prediction_goal: FromCore
+    gaze: FromCore
     look_s: FromCore
 
 

@@ -301,6 +301,9 @@ SEARCH_STRATEGIES: tuple[SearchStrategy, ...] = ("belief", "paper")
 PredictionGoal = Literal["path", "room"]
 """Where go_to_prediction drives (:class:`SearchParams.prediction_goal`)."""
 
+SearchGaze = Literal["unseen", "goal"]
+"""Where the head looks in a search when the gaze rule has nothing (:class:`SearchParams.gaze`)."""
+
 
 @dataclass(frozen=True)
 class SearchParams:
@@ -339,6 +342,13 @@ class SearchParams:
         "Where go_to_prediction drives after a loss: ``path`` (§II-E, the paper: the end of"
         " her predicted path, clipped to the map) or ``room`` (the doorway of the room the"
         " belief over where she can be ranks first a few seconds on).",
+    )
+    gaze: SearchGaze = param(
+        "unseen",
+        "Where the head looks while she is lost (or not seen yet) and no target, belief peak or"
+        " leg candidate draws it: ``unseen`` (the most probable place not seen since the loss"
+        " that is in sight, e.g. into each room the robot drives past;"
+        " :mod:`pfctl.core.search.gaze`) or ``goal`` (where the base is going).",
     )
     look_s: float = param(
         6.0,

@@ -102,6 +102,8 @@ class Perception:
         self.last_visible: NDArray[np.bool_] | None = None
         """The belief grid's cells the last frame saw (Eq. 4's visible mask; None without a
         belief or a frame yet)."""
+        self.camera_hfov: float | None = None
+        """The camera's horizontal field of view, rad (None before the first frame)."""
 
     def on_scan(
         self, scan: LaserScan, classified: ClassifiedSegments | None = None
@@ -127,6 +129,7 @@ class Perception:
         if self.detector is None:
             return ()
         people = self.detector.detect(frame)
+        self.camera_hfov = frame.info.horizontal_fov
         fov = FieldOfView.from_frame(frame, self.camera_range[1], self.camera_range[0])
         detections = [Detection(d.position[0], d.position[1], d.score) for d in people]
         self._camera_people = (frame.stamp, np.array([[d.x, d.y] for d in detections]))
