@@ -348,7 +348,9 @@ class WaypointSearch(Action):
     for a target lost, ``search.never_seen_strategy`` for one not seen yet in the run — it
     looks where the belief over where she can be says (:meth:`_act_belief`), and uses
     Algorithm 1 only when that belief has no place left to look. A target named during the
-    search but not detected lately is looked back at (:meth:`Leaf.hold_on_target`)."""
+    search but not detected lately is looked back at (:meth:`Leaf.hold_on_target`), and a
+    person standing in her clothes whose face has not decided is gone up to first
+    (:meth:`_approach_candidate`)."""
 
     spec = LeafSpec(
         "waypoint_search",
@@ -357,6 +359,7 @@ class WaypointSearch(Action):
         "running until the target is found, failure when nothing is left to search.",
         (param("tolerance", 0.4, "arrival distance at a way-point, m", minimum=0.05),),
     )
+    reads = (*Leaf.reads, "candidate")
     writes = ("waypoint",)
 
     REPLAN_S: ClassVar[float] = 3.0
@@ -374,6 +377,15 @@ class WaypointSearch(Action):
     INSIDE_LOOKS: ClassVar[int] = 3
     #: Head sweep to either side of the room's bearing while looking, rad.
     LOOK_PAN: ClassVar[float] = 0.9
+    #: A candidate (blackboard ``candidate``) slower than this (m/s) is standing: gone up to.
+    STANDING: ClassVar[float] = 0.2
+    #: ... to this far from them, m: close enough for her face (> 14 px at 320x240 within
+    #: 3.2 m) and her clothes to decide, far enough not to crowd them.
+    APPROACH_TO: ClassVar[float] = 2.2
+    #: ... for at most this long per person, s; then the search goes on past them.
+    APPROACH_S: ClassVar[float] = 15.0
+    #: Height of the face the head aims at while going up to a candidate, m.
+    FACE_HEIGHT: ClassVar[float] = 1.55
 
     def initialise(self) -> None:
         self._start = self.t
@@ -388,6 +400,35 @@ class WaypointSearch(Action):
         self._unreachable: dict[tuple[str, str], float] = {}
         """Looks the robot could not drive to, and when: skipped for ``RETRY_S``."""
         self._inside: dict[str, int] = {}
+        self._approached: dict[int, float] = {}
+        """Candidates gone up to, and when that began."""
+
+    def _approach_candidate(self) -> bool:
+        """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
+        no face seen, not named), head on their face, to ``APPROACH_TO`` m, for at most
+        ``APPROACH_S`` per person. Seen across a room through a door, 5 m off, her clothes
+        match only weakly (S ≈ 0.65) and her face is too small to count; nearer, one or the
+        other decides. A walker is not chased (they walk on; the search's gaze keeps them in
+        sight as it can). False (nothing done) when there is no such person."""
+        c: TargetState | None = self.bb.candidate
+        if c is None or math.hypot(c.vx, c.vy) >= self.STANDING:
+            return False
+        began = self._approached.setdefault(c.track_id, self.t)
+        if self.t - began >= self.APPROACH_S:
+            return False
+        self.intents.look_at(c.xy, "candidate", self.FACE_HEIGHT)
+        pose = self.bb.pose
+        d = math.hypot(pose.x - c.x, pose.y - c.y)
+        if d <= self.APPROACH_TO:
+            self.intents.stop()
+            return True
+        k = self.APPROACH_TO / d
+        goal = (c.x + (pose.x - c.x) * k, c.y + (pose.y - c.y) * k)
+        facing = math.atan2(c.y - goal[1], c.x - goal[0])
+        if self.intents.go_to(goal, self.params["tolerance"], facing) == "failed":
+            self._approached[c.track_id] = -math.inf  # no way there: on with the search
+            return False
+        return True
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
         return all(math.dist(goal, v) >= self.VISITED_RADIUS for v in self._visited)
@@ -463,6 +504,9 @@ class WaypointSearch(Action):
         if self.visible():
             return Status.SUCCESS
         if self.hold_on_target(self._start):
+            return Status.RUNNING
+        if self._approach_candidate():
+            self._decision, self._look, self._looking_since = None, None, None
             return Status.RUNNING
         search = self.world.search
         strategy = search.strategy if self.last_seen is not None else search.never_seen_strategy
