@@ -24,12 +24,14 @@ from typing import Any, ClassVar
 import numpy as np
 import py_trees
 from py_trees.common import Access, Status
+from scipy.ndimage import binary_dilation
 
 from pfctl.core.behavior.blackboard import PredictionState, Sighting, TargetState
 from pfctl.core.behavior.intents import Intents
 from pfctl.core.behavior.spec import LeafSpec, param
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import sweep_pan
+from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.regions import WaypointDecision
 from pfctl.core.perception.viewpoints import face_viewpoint, nearest_viewpoint
 from pfctl.core.search.next_look import Look, rank_looks
@@ -377,6 +379,10 @@ class WaypointSearch(Action):
     INSIDE_LOOKS: ClassVar[int] = 3
     #: Head sweep to either side of the room's bearing while looking, rad.
     LOOK_PAN: ClassVar[float] = 0.9
+    #: A frontier cluster round which the camera has seen this share of the places a person
+    #: could stand (within ``LOOKED_RADIUS`` m) since the loss is not worth a visit.
+    LOOKED_SHARE: ClassVar[float] = 0.9
+    LOOKED_RADIUS: ClassVar[float] = 0.6
     #: A candidate (blackboard ``candidate``) slower than this (m/s) is standing: gone up to.
     STANDING: ClassVar[float] = 0.2
     #: ... to this far from them, m: close enough for her face (> 14 px at 320x240 within
@@ -456,8 +462,34 @@ class WaypointSearch(Action):
         self.bb.waypoint = decision
         return decision
 
+    def _looked_at(self, cluster: FrontierCluster) -> bool:
+        """Whether the camera has seen, since the loss, at least ``LOOKED_SHARE`` of the
+        places a person could stand within ``LOOKED_RADIUS`` of ``cluster``: a frontier stands
+        for places the laser has not mapped, and is worth a visit only while she could be
+        there unseen. Round a kitchen's furniture the laser leaves frontiers long after the
+        camera has looked over the room (generated home 16: 50 s of way-points in the kitchen
+        while she stood in the bedroom)."""
+        wb = self.world.whereabouts
+        if wb is None or not wb.active:
+            return False
+        r = round(self.LOOKED_RADIUS / wb.geometry.resolution)
+        rows, cols = cluster.cells[:, 0], cluster.cells[:, 1]
+        r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
+        r1, c1 = int(rows.max()) + r + 1, int(cols.max()) + r + 1
+        near = np.zeros((r1 - r0, c1 - c0), dtype=bool)
+        near[rows - r0, cols - c0] = True
+        near = binary_dilation(near, np.ones((2 * r + 1, 2 * r + 1), dtype=bool))
+        walkable = wb.labels[r0:r1, c0:c1] >= 0
+        places = near[: walkable.shape[0], : walkable.shape[1]] & walkable
+        n = int(places.sum())
+        if n == 0:
+            return False
+        seen = np.isfinite(wb.seen_at[r0:r1, c0:c1]) & places
+        return int(seen.sum()) >= self.LOOKED_SHARE * n
+
     def _unvisited(self, decision: WaypointDecision) -> WaypointDecision:
-        """``decision`` without the places already visited. A cluster whose goal (its point
+        """``decision`` without the places already visited, nor the frontiers round which the
+        camera has looked (:meth:`_looked_at`). A cluster whose goal (its point
         nearest l*) was visited but which is still a frontier — the robot got there and could
         not see past an obstacle, e.g. round the end of a bookshelf — gets its nearest point
         that is not near a visited way-point (keeping its utility): the robot follows the
@@ -474,6 +506,10 @@ class WaypointSearch(Action):
         for cluster, goal, u in zip(
             decision.clusters, decision.goals, decision.utilities, strict=True
         ):
+            if self._looked_at(cluster):
+                goals.append(goal)
+                utilities.append(-math.inf)
+                continue
             if self._fresh(goal):
                 goals.append(goal)
                 utilities.append(u)
@@ -510,7 +546,9 @@ class WaypointSearch(Action):
             return Status.RUNNING
         search = self.world.search
         strategy = search.strategy if self.last_seen is not None else search.never_seen_strategy
-        if strategy == "belief" and self.world.whereabouts is not None:
+        believe = self.world.whereabouts is not None and self.world.whereabouts.active
+        if believe and (strategy == "belief" or self._look is not None):
+            # strategy paper: a look the belief chose when the frontiers ran out goes on
             status = self._act_belief()
             if status is not None:
                 return status
@@ -519,6 +557,12 @@ class WaypointSearch(Action):
             decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
+        if believe and decision.reason == "visited_fallback":
+            # no frontier is worth a visit (each visited, or looked round by the camera): look
+            # where the belief over where she can be says, not at l* again
+            status = self._act_belief()
+            if status is not None:
+                return status
         outcome = self.intents.go_to(decision.waypoint, self.params["tolerance"])
         if outcome == "running":
             return Status.RUNNING

@@ -115,10 +115,11 @@ def test_waypoint_search_follows_a_visited_frontier_along_from_the_robot_when_ne
     )
     ns = new_namespace()
     writer = py_trees.blackboard.Client(name="test", namespace=ns)
-    for key in ("pose", "t"):
+    for key in ("pose", "t", "world"):
         writer.register_key(key, access=Access.WRITE)
     writer.pose = Pose2D(1.6, 7.4)  # below the middle of the frontier; l* at its east end
     writer.t = 0.0
+    writer.world = SimpleNamespace(whereabouts=None)  # no belief: every frontier counts
     leaf = WaypointSearch("waypoint_search", ns, {"tolerance": 0.4})
     leaf.initialise()
     leaf._visited.append((1.6, 7.8))

@@ -7,6 +7,7 @@ from __future__ import annotations
 import itertools
 import math
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -236,9 +237,10 @@ def test_a_target_never_seen_is_searched_for_by_never_seen_strategy(
 def _leaf_with_pose(pose: Pose2D) -> WaypointSearch:
     namespace = new_namespace()
     writer = py_trees.blackboard.Client(name="test", namespace=namespace)
-    for key in ("pose", "t"):
+    for key in ("pose", "t", "world"):
         writer.register_key(key, access=Access.WRITE)
     writer.pose, writer.t = pose, 0.0
+    writer.world = SimpleNamespace(whereabouts=None)  # no belief: every frontier counts
     leaf = WaypointSearch("waypoint_search", namespace, {"tolerance": 0.4})
     leaf.initialise()
     return leaf

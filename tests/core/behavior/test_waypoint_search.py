@@ -1,0 +1,155 @@
+"""The way-point search leaf on constructed maps. It goes up to a standing person in her clothes
+whose face has not decided (generated home 50: seen through a door 5 m off, S ≈ 0.65, her face
+too small to count): to ``APPROACH_TO`` m, head on the face, for at most ``APPROACH_S`` per
+person; walkers are not chased, and a person it cannot reach is left. It leaves the frontiers
+round which the camera has looked, and with none worth a visit it looks where the belief says."""
+
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import py_trees
+import pytest
+from py_trees.common import Access, Status
+
+from pfctl.core.behavior.blackboard import KEYS, TargetState, new_namespace
+from pfctl.core.behavior.leaves import WaypointSearch
+from pfctl.core.mapping.frontiers import FrontierCluster
+from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
+from pfctl.core.robot import Pose2D
+from pfctl.core.search.whereabouts import Whereabouts
+from tests.core.behavior.test_see_face import Intents, _room
+from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
+
+
+class Rig:
+    def __init__(self) -> None:
+        ns = new_namespace()
+        self.leaf = WaypointSearch("waypoint_search", ns, {"tolerance": 0.4})
+        self.leaf.setup()
+        self.bb = py_trees.blackboard.Client(name="rig", namespace=ns)
+        for key in KEYS:
+            self.bb.register_key(key, access=Access.WRITE)
+        self.intents = Intents()
+        self.stops = 0
+        self.intents.stop = self._stop  # type: ignore[method-assign]
+        self.bb.world = SimpleNamespace(planner=_room())
+        self.bb.intents, self.bb.target, self.bb.last_seen, self.bb.prediction = (
+            self.intents,
+            None,
+            None,
+            None,
+        )
+        self.bb.t, self.bb.pose, self.bb.candidate = 0.0, Pose2D(1.0, 3.0), None
+        self.leaf.initialise()
+
+    def _stop(self) -> None:
+        self.stops += 1
+
+    def approach(self, t: float, candidate: TargetState | None, pose: Pose2D) -> bool:
+        self.bb.t, self.bb.pose, self.bb.candidate = t, pose, candidate
+        return self.leaf._approach_candidate()
+
+
+def test_a_standing_candidate_is_gone_up_to_head_on_the_face_then_left_after_a_while() -> None:
+    rig = Rig()
+    her = TargetState(4, 6.0, 3.0, 0.05, 0.0, 0.0)  # standing, 5 m east of the robot
+    robot = Pose2D(1.0, 3.0)
+    assert rig.approach(0.0, her, robot)
+    goal = rig.intents.goals[-1]
+    assert math.dist(goal, her.xy) == pytest.approx(WaypointSearch.APPROACH_TO)
+    assert goal[0] < her.x  # on the robot's side of her
+    assert rig.intents.looks[-1] == (her.xy, "candidate", WaypointSearch.FACE_HEIGHT)
+    # close enough: the base stops, the head stays on her
+    near = Pose2D(6.0 - WaypointSearch.APPROACH_TO + 0.1, 3.0)
+    assert rig.approach(5.0, her, near) and rig.stops == 1
+    # her face never turned to the robot: after APPROACH_S the search goes on past her
+    assert not rig.approach(WaypointSearch.APPROACH_S + 0.1, her, near)
+    someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
+    assert rig.approach(WaypointSearch.APPROACH_S + 0.2, someone_else, near)
+
+
+def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
+    rig = Rig()
+    assert not rig.approach(0.0, None, Pose2D(1.0, 3.0))
+    walker = TargetState(6, 6.0, 3.0, 0.7, 0.0, 0.0)
+    assert not rig.approach(0.1, walker, Pose2D(1.0, 3.0))
+    assert rig.intents.goals == [] and rig.intents.looks == []
+
+
+def test_a_candidate_it_cannot_drive_to_is_left_at_once() -> None:
+    rig = Rig()
+    rig.intents.nav = "failed"
+    her = TargetState(7, 6.0, 3.0, 0.0, 0.0, 0.0)
+    assert not rig.approach(0.0, her, Pose2D(1.0, 3.0))
+    rig.intents.nav = "running"
+    assert not rig.approach(0.1, her, Pose2D(1.0, 3.0))  # not tried again
+
+
+def test_the_leaf_runs_the_approach_before_its_search() -> None:
+    rig = Rig()
+    her = TargetState(8, 6.0, 3.0, 0.0, 0.0, 0.0)
+    rig.bb.t, rig.bb.candidate = 0.1, her
+    rig.leaf.tick_once()
+    assert rig.leaf.status is Status.RUNNING
+    assert rig.intents.looks[-1][1] == "candidate"
+
+
+def _frontier(wb: Whereabouts, x0: float, x1: float, y: float) -> FrontierCluster:
+    """A frontier along ``y`` from ``x0`` to ``x1`` on the whereabouts' grid."""
+    xs = np.arange(x0, x1, wb.geometry.resolution)
+    points = np.column_stack([xs, np.full_like(xs, y)])
+    cells = np.array([wb.geometry.world_to_cell(p) for p in points], dtype=np.intp)
+    return FrontierCluster(cells, points, (float(xs.mean()), y), len(xs))
+
+
+def test_a_frontier_the_camera_has_looked_round_is_not_worth_a_visit() -> None:
+    """Generated home 16: round the kitchen's furniture the laser left frontiers long after
+    the camera had looked over the room. A frontier counts as looked at once the camera has
+    seen LOOKED_SHARE of the places within LOOKED_RADIUS of it since the loss."""
+    rig = Rig()
+    wb = Whereabouts(RegionMap(HOME), GEOMETRY, np.ones(GEOMETRY.shape, dtype=bool), PARAMS)
+    rig.bb.world = SimpleNamespace(whereabouts=wb, planner=_room())
+    frontier = _frontier(wb, 4.0, 5.0, 3.5)  # in the mid room
+    assert not rig.leaf._looked_at(frontier)  # the belief rests: every frontier counts
+    wb.lost(0.0, (4.5, 1.0), heading="mid")
+    assert not rig.leaf._looked_at(frontier)
+    xy = GEOMETRY.cell_to_world(*np.indices(GEOMETRY.shape))
+    near = np.hypot(xy[..., 0] - 4.5, xy[..., 1] - 3.5) < 1.5
+    wb.observe(2.0, near & (xy[..., 0] < 4.4))  # the camera saw the west half round it
+    assert not rig.leaf._looked_at(frontier)
+    wb.observe(3.0, near)  # and then all round it
+    assert rig.leaf._looked_at(frontier)
+    assert not rig.leaf._looked_at(_frontier(wb, 7.0, 8.0, 3.5))  # the east room: not seen
+
+
+def test_with_no_frontier_worth_a_visit_the_paper_strategy_looks_where_the_belief_says() -> None:
+    """Every frontier visited or looked round: rather than l*'s point again, the leaf looks
+    where the belief over where she can be says (the likely room's doorway first), and goes
+    on with that look once chosen."""
+    rig = Rig()
+    wb = Whereabouts(RegionMap(HOME), GEOMETRY, np.ones(GEOMETRY.shape, dtype=bool), PARAMS)
+    wb.lost(0.0, (6.5, 1.0), heading="east", came_from="west")
+    wb.observe(8.0, wb.labels == wb.regions.names.index("corridor"))  # the robot's own corridor
+    spent = WaypointDecision(
+        waypoint=(7.5, 3.5),
+        heading_region="east",
+        target_region="east",
+        target_point=(7.5, 3.5),
+        reason="visited_fallback",
+    )
+    rig.bb.world = SimpleNamespace(
+        whereabouts=wb,
+        planner=_room(),
+        search=SearchParams(strategy="paper"),
+        next_waypoint=lambda history, here: spent,
+    )
+    control = SimpleNamespace(max_linear_speed=0.22, max_angular_speed=0.8)
+    rig.intents.control = control  # type: ignore[attr-defined]
+    rig.bb.t, rig.bb.pose = 8.0, Pose2D(2.0, 1.0)
+    rig.leaf.tick_once()
+    assert rig.leaf.status is Status.RUNNING
+    assert rig.intents.goals[-1] == (7.5, 2.0)  # the east room's doorway, not l*'s point
+    assert rig.leaf._look is not None and rig.leaf._look.region == "east"
