@@ -359,7 +359,23 @@ class WaypointSearch(Action):
         "action",
         "Algorithm 1: go to the best frontier toward the heading region, look, repeat; "
         "running until the target is found, failure when nothing is left to search.",
-        (param("tolerance", 0.4, "arrival distance at a way-point, m", minimum=0.05),),
+        (
+            param("tolerance", 0.4, "arrival distance at a way-point, m", minimum=0.05),
+            param(
+                "approach_s",
+                15.0,
+                "go up to a standing person in her clothes whose face has not decided, for at"
+                " most this long each, s (0: never)",
+                minimum=0.0,
+            ),
+            param(
+                "looked_round",
+                True,
+                "skip the frontiers the camera has looked round since the loss, and with none"
+                " left look where the belief says (false: Algorithm 1 as the paper has it)",
+                kind=bool,
+            ),
+        ),
     )
     reads = (*Leaf.reads, "candidate")
     writes = ("waypoint",)
@@ -388,8 +404,6 @@ class WaypointSearch(Action):
     #: ... to this far from them, m: close enough for her face (> 14 px at 320x240 within
     #: 3.2 m) and her clothes to decide, far enough not to crowd them.
     APPROACH_TO: ClassVar[float] = 2.2
-    #: ... for at most this long per person, s; then the search goes on past them.
-    APPROACH_S: ClassVar[float] = 15.0
     #: Height of the face the head aims at while going up to a candidate, m.
     FACE_HEIGHT: ClassVar[float] = 1.55
 
@@ -412,15 +426,16 @@ class WaypointSearch(Action):
     def _approach_candidate(self) -> bool:
         """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
         no face seen, not named), head on their face, to ``APPROACH_TO`` m, for at most
-        ``APPROACH_S`` per person. Seen across a room through a door, 5 m off, her clothes
+        ``approach_s`` per person. Seen across a room through a door, 5 m off, her clothes
         match only weakly (S ≈ 0.65) and her face is too small to count; nearer, one or the
         other decides. A walker is not chased (they walk on; the search's gaze keeps them in
         sight as it can). False (nothing done) when there is no such person."""
         c: TargetState | None = self.bb.candidate
-        if c is None or math.hypot(c.vx, c.vy) >= self.STANDING:
+        seconds = float(self.params["approach_s"])
+        if c is None or seconds <= 0.0 or math.hypot(c.vx, c.vy) >= self.STANDING:
             return False
         began = self._approached.setdefault(c.track_id, self.t)
-        if self.t - began >= self.APPROACH_S:
+        if self.t - began >= seconds:
             return False
         self.intents.look_at(c.xy, "candidate", self.FACE_HEIGHT)
         pose = self.bb.pose
@@ -470,7 +485,7 @@ class WaypointSearch(Action):
         camera has looked over the room (generated home 16: 50 s of way-points in the kitchen
         while she stood in the bedroom)."""
         wb = self.world.whereabouts
-        if wb is None or not wb.active:
+        if wb is None or not wb.active or not self.params["looked_round"]:
             return False
         r = round(self.LOOKED_RADIUS / wb.geometry.resolution)
         rows, cols = cluster.cells[:, 0], cluster.cells[:, 1]
@@ -557,7 +572,7 @@ class WaypointSearch(Action):
             decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        if believe and decision.reason == "visited_fallback":
+        if believe and self.params["looked_round"] and decision.reason == "visited_fallback":
             # no frontier is worth a visit (each visited, or looked round by the camera): look
             # where the belief over where she can be says, not at l* again
             status = self._act_belief()

@@ -1,6 +1,6 @@
 """The way-point search leaf on constructed maps. It goes up to a standing person in her clothes
 whose face has not decided (generated home 50: seen through a door 5 m off, S ≈ 0.65, her face
-too small to count): to ``APPROACH_TO`` m, head on the face, for at most ``APPROACH_S`` per
+too small to count): to ``APPROACH_TO`` m, head on the face, for at most ``approach_s`` per
 person; walkers are not chased, and a person it cannot reach is left. It leaves the frontiers
 round which the camera has looked, and with none worth a visit it looks where the belief says."""
 
@@ -23,11 +23,14 @@ from pfctl.core.search.whereabouts import Whereabouts
 from tests.core.behavior.test_see_face import Intents, _room
 from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
 
+APPROACH_S = 15.0  # the leaf's default approach_s
+
 
 class Rig:
     def __init__(self) -> None:
         ns = new_namespace()
-        self.leaf = WaypointSearch("waypoint_search", ns, {"tolerance": 0.4})
+        params = {p.name: p.default for p in WaypointSearch.spec.params}
+        self.leaf = WaypointSearch("waypoint_search", ns, params)
         self.leaf.setup()
         self.bb = py_trees.blackboard.Client(name="rig", namespace=ns)
         for key in KEYS:
@@ -65,10 +68,10 @@ def test_a_standing_candidate_is_gone_up_to_head_on_the_face_then_left_after_a_w
     # close enough: the base stops, the head stays on her
     near = Pose2D(6.0 - WaypointSearch.APPROACH_TO + 0.1, 3.0)
     assert rig.approach(5.0, her, near) and rig.stops == 1
-    # her face never turned to the robot: after APPROACH_S the search goes on past her
-    assert not rig.approach(WaypointSearch.APPROACH_S + 0.1, her, near)
+    # her face never turned to the robot: after approach_s the search goes on past her
+    assert not rig.approach(APPROACH_S + 0.1, her, near)
     someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
-    assert rig.approach(WaypointSearch.APPROACH_S + 0.2, someone_else, near)
+    assert rig.approach(APPROACH_S + 0.2, someone_else, near)
 
 
 def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
@@ -153,3 +156,17 @@ def test_with_no_frontier_worth_a_visit_the_paper_strategy_looks_where_the_belie
     assert rig.leaf.status is Status.RUNNING
     assert rig.intents.goals[-1] == (7.5, 2.0)  # the east room's doorway, not l*'s point
     assert rig.leaf._look is not None and rig.leaf._look.region == "east"
+
+
+def test_the_paper_literal_leaf_neither_goes_up_to_anyone_nor_skips_a_frontier() -> None:
+    """``approach_s: 0`` and ``looked_round: false`` (``missions/trees/paper_literal.yaml``):
+    Algorithm 1 as the paper has it."""
+    rig = Rig()
+    rig.leaf.params.update(approach_s=0.0, looked_round=False)
+    her = TargetState(4, 6.0, 3.0, 0.0, 0.0, 0.0)
+    assert not rig.approach(0.0, her, Pose2D(1.0, 3.0))
+    wb = Whereabouts(RegionMap(HOME), GEOMETRY, np.ones(GEOMETRY.shape, dtype=bool), PARAMS)
+    wb.lost(0.0, (4.5, 1.0), heading="mid")
+    wb.observe(1.0, np.ones(GEOMETRY.shape, dtype=bool))  # everything seen
+    rig.bb.world = SimpleNamespace(whereabouts=wb, planner=_room())
+    assert not rig.leaf._looked_at(_frontier(wb, 4.0, 5.0, 3.5))
