@@ -404,8 +404,14 @@ class WaypointSearch(Action):
     #: ... to this far from them, m: close enough for her face (> 14 px at 320x240 within
     #: 3.2 m) and her clothes to decide, far enough not to crowd them.
     APPROACH_TO: ClassVar[float] = 2.2
-    #: Height of the face the head aims at while going up to a candidate, m.
-    FACE_HEIGHT: ClassVar[float] = 1.55
+    #: ... and no nearer than this, m; the line of sight keeps ``APPROACH_CLEARANCE`` m from
+    #: walls and furniture.
+    APPROACH_MIN: ClassVar[float] = 1.0
+    APPROACH_CLEARANCE: ClassVar[float] = 0.2
+    #: The place to see them from is chosen again this often, s, and reached within this
+    #: distance, m (a place at a door's edge is a few centimetres from one behind its jamb).
+    APPROACH_REPLAN_S: ClassVar[float] = 1.0
+    APPROACH_TOLERANCE: ClassVar[float] = 0.1
 
     def initialise(self) -> None:
         self._start = self.t
@@ -422,14 +428,19 @@ class WaypointSearch(Action):
         self._inside: dict[str, int] = {}
         self._approached: dict[int, float] = {}
         """Candidates gone up to, and when that began."""
+        self._approach_place: tuple[int, float, tuple[float, float]] | None = None
+        """The candidate's track, when its place to be seen from was chosen, and the place."""
 
     def _approach_candidate(self) -> bool:
         """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
-        no face seen, not named), head on their face, to ``APPROACH_TO`` m, for at most
-        ``approach_s`` per person. Seen across a room through a door, 5 m off, her clothes
-        match only weakly (S ≈ 0.65) and her face is too small to count; nearer, one or the
-        other decides. A walker is not chased (they walk on; the search's gaze keeps them in
-        sight as it can). False (nothing done) when there is no such person."""
+        no face seen, not named), head on them, for at most ``approach_s`` per person: to
+        the nearest place within ``APPROACH_TO`` m of them from which they are in sight
+        (:func:`~pfctl.core.perception.viewpoints.nearest_viewpoint`, re-chosen every
+        ``APPROACH_REPLAN_S``), so the laser sees their legs too. Seen across a room through a
+        door, 5 m off, her clothes match only weakly (S ≈ 0.65) and her face is too small to
+        count; nearer, one or the other decides. A walker is not chased (they walk on; the
+        search's gaze keeps them in sight as it can). False (nothing done) when there is no
+        such person."""
         c: TargetState | None = self.bb.candidate
         seconds = float(self.params["approach_s"])
         if c is None or seconds <= 0.0 or math.hypot(c.vx, c.vy) >= self.STANDING:
@@ -437,18 +448,30 @@ class WaypointSearch(Action):
         began = self._approached.setdefault(c.track_id, self.t)
         if self.t - began >= seconds:
             return False
-        self.intents.look_at(c.xy, "candidate", self.FACE_HEIGHT)
         pose = self.bb.pose
-        d = math.hypot(pose.x - c.x, pose.y - c.y)
-        if d <= self.APPROACH_TO:
-            self.intents.stop()
-            return True
-        k = self.APPROACH_TO / d
-        goal = (c.x + (pose.x - c.x) * k, c.y + (pose.y - c.y) * k)
+        place = self._approach_place
+        if place is None or place[0] != c.track_id or self.t - place[1] >= self.APPROACH_REPLAN_S:
+            found = nearest_viewpoint(
+                self.world.planner,
+                (pose.x, pose.y),
+                c.xy,
+                self.APPROACH_TO,
+                self.APPROACH_MIN,
+                self.APPROACH_CLEARANCE,
+            )
+            if found is None:
+                self._approached[c.track_id] = -math.inf  # no place to see them from
+                return False
+            place = self._approach_place = (c.track_id, self.t, found.xy)
+        self.intents.look_at(c.xy, "candidate")  # the torso: the whole person and the face in view
+        goal = place[2]
         facing = math.atan2(c.y - goal[1], c.x - goal[0])
-        if self.intents.go_to(goal, self.params["tolerance"], facing) == "failed":
+        outcome = self.intents.go_to(goal, self.APPROACH_TOLERANCE, facing)
+        if outcome == "failed":
             self._approached[c.track_id] = -math.inf  # no way there: on with the search
             return False
+        if outcome == "arrived":
+            self.intents.stop()
         return True
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
@@ -572,9 +595,9 @@ class WaypointSearch(Action):
             decision = self._decide()
         if decision.reason == "no_target":
             return Status.FAILURE
-        if believe and self.params["looked_round"] and decision.reason == "visited_fallback":
-            # no frontier is worth a visit (each visited, or looked round by the camera): look
-            # where the belief over where she can be says, not at l* again
+        if believe and self.params["looked_round"] and decision.reason != "frontier":
+            # no frontier is worth a visit (each visited, looked round by the camera, or none
+            # reachable): look where the belief over where she can be says, not at l* again
             status = self._act_belief()
             if status is not None:
                 return status

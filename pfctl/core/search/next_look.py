@@ -4,8 +4,8 @@ Every region the belief (:class:`~pfctl.core.search.whereabouts.Whereabouts`) gi
 candidate, with the place to look into it from:
 
 - a region the robot is not in, not yet looked into: its **doorway** on the robot's way there
-  (the door midpoint on the shortest region path, :meth:`RegionMap.region_path`) — a head sweep
-  from the door sees most of a room without driving around in it;
+  (the door midpoint on the shortest region path, :meth:`RegionMap.region_path`, a step into
+  the room) — a head sweep from there sees most of a room without driving around in it;
 - a region already looked into from its door, or the robot's own region: **inside**, the cell
   not seen lately that is nearest the centre of the region's unseen cells — the occluded parts,
   behind shelves, that Algorithm 1's frontiers (Eq. 2/3) stand for in a known map.
@@ -33,7 +33,10 @@ from pfctl.core.search.whereabouts import Whereabouts
 XY = tuple[float, float]
 LookKind = Literal["doorway", "inside"]
 
-__all__ = ["Look", "LookKind", "doorway", "rank_looks"]
+__all__ = ["STEP_IN", "Look", "LookKind", "doorway", "rank_looks"]
+
+#: A room is looked into from this far inside its door, m (:func:`_step_in`).
+STEP_IN = 0.5
 
 
 @dataclass(frozen=True)
@@ -77,6 +80,18 @@ def doorway(regions: RegionMap, here: XY, region: str) -> tuple[XY, float] | Non
     return point, length
 
 
+def _step_in(door: XY, centre: XY) -> XY:
+    """The place to look into a room from: ``STEP_IN`` m from its ``door`` (midpoint) toward its
+    ``centre``. On the threshold the door's jambs hide the room's walls either side of the door
+    (generated home 6: she stood 1.5 m to the side of the bedroom's door, unseen from the
+    corridor); a step in, the head's sweep takes in the whole room."""
+    d = math.dist(door, centre)
+    if d <= STEP_IN:
+        return centre
+    k = STEP_IN / d
+    return (door[0] + (centre[0] - door[0]) * k, door[1] + (centre[1] - door[1]) * k)
+
+
 def _inside_point(wb: Whereabouts, t: float, region: str) -> XY | None:
     """The unseen cell of ``region`` nearest the centre of its unseen cells (None if all seen)."""
     cells = wb.unseen_cells(t, region)
@@ -115,7 +130,7 @@ def rank_looks(
         look_at = inner if inner is not None else wb.regions.region_point(region)
         door = doorway(wb.regions, here, region)
         if door is not None and region not in looked_from_door and (region, "doorway") not in skip:
-            viewpoint, length = door
+            viewpoint, length = _step_in(door[0], wb.regions.region_point(region)), door[1]
             kind: LookKind = "doorway"
         elif inner is not None and (region, "inside") not in skip:
             viewpoint, kind = inner, "inside"

@@ -1,6 +1,6 @@
 """The way-point search leaf on constructed maps. It goes up to a standing person in her clothes
 whose face has not decided (generated home 50: seen through a door 5 m off, S ≈ 0.65, her face
-too small to count): to ``APPROACH_TO`` m, head on the face, for at most ``approach_s`` per
+too small to count): to ``APPROACH_TO`` m, head on them, for at most ``approach_s`` per
 person; walkers are not chased, and a person it cannot reach is left. It leaves the frontiers
 round which the camera has looked, and with none worth a visit it looks where the belief says."""
 
@@ -11,14 +11,16 @@ from types import SimpleNamespace
 
 import numpy as np
 import py_trees
-import pytest
 from py_trees.common import Access, Status
 
 from pfctl.core.behavior.blackboard import KEYS, TargetState, new_namespace
 from pfctl.core.behavior.leaves import WaypointSearch
 from pfctl.core.mapping.frontiers import FrontierCluster
+from pfctl.core.mapping.grid import OccupancyGrid
+from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
 from pfctl.core.robot import Pose2D
+from pfctl.core.search.next_look import STEP_IN
 from pfctl.core.search.whereabouts import Whereabouts
 from tests.core.behavior.test_see_face import Intents, _room
 from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
@@ -62,16 +64,40 @@ def test_a_standing_candidate_is_gone_up_to_head_on_the_face_then_left_after_a_w
     robot = Pose2D(1.0, 3.0)
     assert rig.approach(0.0, her, robot)
     goal = rig.intents.goals[-1]
-    assert math.dist(goal, her.xy) == pytest.approx(WaypointSearch.APPROACH_TO)
-    assert goal[0] < her.x  # on the robot's side of her
-    assert rig.intents.looks[-1] == (her.xy, "candidate", WaypointSearch.FACE_HEIGHT)
-    # close enough: the base stops, the head stays on her
-    near = Pose2D(6.0 - WaypointSearch.APPROACH_TO + 0.1, 3.0)
-    assert rig.approach(5.0, her, near) and rig.stops == 1
+    # the nearest place within APPROACH_TO of her: on the robot's side, about that far
+    assert WaypointSearch.APPROACH_TO - 0.1 <= math.dist(goal, her.xy) <= WaypointSearch.APPROACH_TO
+    assert goal[0] < her.x
+    # the head on her torso (the control's look height): her whole body and face in the frame
+    assert rig.intents.looks[-1] == (her.xy, "candidate", None)
+    # there: the base stops, the head stays on her
+    rig.intents.nav = "arrived"
+    assert rig.approach(5.0, her, Pose2D(*goal)) and rig.stops == 1
+    assert rig.intents.looks[-1][1] == "candidate"
     # her face never turned to the robot: after approach_s the search goes on past her
-    assert not rig.approach(APPROACH_S + 0.1, her, near)
+    assert not rig.approach(APPROACH_S + 0.1, her, Pose2D(*goal))
     someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
-    assert rig.approach(APPROACH_S + 0.2, someone_else, near)
+    rig.intents.nav = "running"
+    assert rig.approach(APPROACH_S + 0.2, someone_else, Pose2D(*goal))
+
+
+def test_she_is_gone_up_to_where_she_is_in_sight_not_through_a_wall() -> None:
+    """Generated home 6: she stood in the bedroom 1.5 m to the side of its door, the robot in
+    the corridor; 2.2 m along the straight line to her the robot stood behind the wall, its
+    laser blind to her legs, and she was named only 15 s later. The place is one she is in
+    sight from."""
+    rig = Rig()
+    p = np.zeros((round(6 / 0.05), round(8 / 0.05)))
+    p[:2, :] = p[-2:, :] = p[:, :2] = p[:, -2:] = 1.0
+    p[:, 80:82] = 1.0  # a wall at x = 4 m ...
+    p[90:100, 80:82] = 0.0  # ... with a door at y 4.5-5 m
+    rig.bb.world = SimpleNamespace(
+        planner=GridPlanner(OccupancyGrid.from_probabilities(p, 0.05), 0.2)
+    )
+    her = TargetState(4, 5.0, 2.5, 0.0, 0.0, 0.0)  # beyond the wall, south of the door
+    assert rig.approach(0.0, her, Pose2D(2.5, 2.5))
+    goal = rig.intents.goals[-1]
+    assert goal[0] > 4.1  # through the door, on her side of the wall
+    assert math.dist(goal, her.xy) <= WaypointSearch.APPROACH_TO + 1e-9
 
 
 def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
@@ -154,7 +180,7 @@ def test_with_no_frontier_worth_a_visit_the_paper_strategy_looks_where_the_belie
     rig.bb.t, rig.bb.pose = 8.0, Pose2D(2.0, 1.0)
     rig.leaf.tick_once()
     assert rig.leaf.status is Status.RUNNING
-    assert rig.intents.goals[-1] == (7.5, 2.0)  # the east room's doorway, not l*'s point
+    assert rig.intents.goals[-1] == (7.5, 2.0 + STEP_IN)  # the east room's doorway, not l*'s
     assert rig.leaf._look is not None and rig.leaf._look.region == "east"
 
 

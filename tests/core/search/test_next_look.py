@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from pfctl.core.mapping.regions import RegionMap
-from pfctl.core.search.next_look import doorway, rank_looks
+from pfctl.core.search.next_look import STEP_IN, doorway, rank_looks
 from pfctl.core.search.whereabouts import Whereabouts
 from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
 
@@ -33,7 +33,7 @@ def test_the_next_place_is_the_likely_rooms_doorway_first(lost_heading_east: Whe
     looks = rank_looks(wb, 8.0, (2.0, 1.0), robot_speed=0.22, look_s=6.0)
     best = looks[0]
     assert (best.region, best.kind) == ("east", "doorway")
-    assert best.viewpoint == (7.5, 2.0)
+    assert best.viewpoint == (7.5, 2.0 + STEP_IN)  # a step into the room from its door
     assert best.score == pytest.approx(best.probability / (best.drive_s + 6.0))
     # the unlikely west room behind the robot is no candidate while east is unseen
     assert "west" not in {lk.region for lk in looks}
