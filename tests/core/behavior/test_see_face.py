@@ -12,7 +12,7 @@ import py_trees
 from py_trees.common import Access, Status
 
 from pfctl.core.behavior.blackboard import KEYS, TargetState, new_namespace
-from pfctl.core.behavior.leaves import SeeFace
+from pfctl.core.behavior.leaves import Leaf, SeeFace
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.robot import Pose2D
@@ -32,6 +32,7 @@ class Intents:
 
     def __init__(self) -> None:
         self.goals: list[tuple[float, float]] = []
+        self.stops = 0
         self.looks: list[tuple[tuple[float, float], str, float | None]] = []
         self.nav = "running"
 
@@ -42,7 +43,7 @@ class Intents:
         pass
 
     def stop(self) -> None:
-        pass
+        self.stops += 1
 
     def go_to(self, xy: tuple[float, float], tolerance: float, face: float | None = None) -> str:
         self.goals.append(xy)
@@ -55,11 +56,14 @@ class Intents:
 
 
 class Rig:
-    def __init__(self, **params: Any) -> None:
-        spec = {p.name: p.default for p in SeeFace.spec.params}
+    """A leaf (``leaf_class``, with its defaults and ``params``) on its own blackboard, in the
+    empty room, its intents recorded."""
+
+    def __init__(self, leaf_class: type[Leaf] = SeeFace, **params: Any) -> None:
+        spec = {p.name: p.default for p in leaf_class.spec.params}
         spec.update(params)
         ns = new_namespace()
-        self.leaf = SeeFace("see_face", ns, spec)
+        self.leaf = leaf_class(leaf_class.spec.name, ns, spec)
         self.leaf.setup()
         self.bb = py_trees.blackboard.Client(name="rig", namespace=ns)
         for key in KEYS:

@@ -10,10 +10,9 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
-import py_trees
-from py_trees.common import Access, Status
+from py_trees.common import Status
 
-from pfctl.core.behavior.blackboard import KEYS, TargetState, new_namespace
+from pfctl.core.behavior.blackboard import TargetState
 from pfctl.core.behavior.leaves import WaypointSearch
 from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.grid import OccupancyGrid
@@ -22,43 +21,29 @@ from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
 from pfctl.core.robot import Pose2D
 from pfctl.core.search.next_look import STEP_IN
 from pfctl.core.search.whereabouts import Whereabouts
-from tests.core.behavior.test_see_face import Intents, _room
+from tests.core.behavior.test_see_face import Rig as LeafRig
+from tests.core.behavior.test_see_face import _room
 from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
 
 APPROACH_S = 15.0  # the leaf's default approach_s
 
 
-class Rig:
+class Rig(LeafRig):
     def __init__(self) -> None:
-        ns = new_namespace()
-        params = {p.name: p.default for p in WaypointSearch.spec.params}
-        self.leaf = WaypointSearch("waypoint_search", ns, params)
-        self.leaf.setup()
-        self.bb = py_trees.blackboard.Client(name="rig", namespace=ns)
-        for key in KEYS:
-            self.bb.register_key(key, access=Access.WRITE)
-        self.intents = Intents()
-        self.stops = 0
-        self.intents.stop = self._stop  # type: ignore[method-assign]
-        self.bb.world = SimpleNamespace(planner=_room())
-        self.bb.intents, self.bb.target, self.bb.last_seen, self.bb.prediction = (
-            self.intents,
-            None,
-            None,
-            None,
-        )
+        super().__init__(WaypointSearch)
         self.bb.t, self.bb.pose, self.bb.candidate = 0.0, Pose2D(1.0, 3.0), None
         self.leaf.initialise()
 
-    def _stop(self) -> None:
-        self.stops += 1
+    @property
+    def stops(self) -> int:
+        return self.intents.stops
 
     def approach(self, t: float, candidate: TargetState | None, pose: Pose2D) -> bool:
         self.bb.t, self.bb.pose, self.bb.candidate = t, pose, candidate
         return self.leaf._approach_candidate()
 
 
-def test_a_standing_candidate_is_gone_up_to_head_on_the_face_then_left_after_a_while() -> None:
+def test_a_standing_candidate_is_gone_up_to_head_on_them_then_left_after_a_while() -> None:
     rig = Rig()
     her = TargetState(4, 6.0, 3.0, 0.05, 0.0, 0.0)  # standing, 5 m east of the robot
     robot = Pose2D(1.0, 3.0)
