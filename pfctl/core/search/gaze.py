@@ -38,8 +38,8 @@ _BINS = 72
 
 @dataclass(frozen=True)
 class UnseenView:
-    """The best window: where to look (``xy``, on the bearing at the mass's median range), the
-    bearing (map frame, rad) and the belief mass of the unseen cells in the window."""
+    """A window of bearings: where to look (``xy``, on its centre bearing at the median range
+    of its unseen cells), that bearing (map frame, rad) and the belief mass of those cells."""
 
     xy: XY
     bearing: float
