@@ -25,7 +25,8 @@ from tests.core.behavior.test_see_face import Rig as LeafRig
 from tests.core.behavior.test_see_face import _room
 from tests.core.search.test_whereabouts import GEOMETRY, HOME, PARAMS
 
-APPROACH_S = 15.0  # the leaf's default approach_s
+APPROACH_S = next(p.default for p in WaypointSearch.spec.params if p.name == "approach_s")
+"""The leaf's default ``approach_s``, s."""
 
 
 class Rig(LeafRig):
