@@ -138,7 +138,9 @@ def test_observe_over_ros(ros_master, ros_nodes):
     """Scan (REP-117 values), pose, head, odometry, truth, an RGB-D frame and its person, the
     step clock under sim time (set by a simulator started after the follower's node); limits:
     base and head commands clamped; close publishes zero."""
-    got, fake, driver = _observe(ros_master, ros_nodes, "--sim-time", "--truth", late=True)
+    got, fake, driver = _observe(
+        ros_master, ros_nodes, "--sim-time", "--truth", driver_args=("--truth",), late=True
+    )
     assert got["use_sim_time"] is True
 
     scan = got["scan"]

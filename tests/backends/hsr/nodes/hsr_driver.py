@@ -4,7 +4,8 @@ prints one JSON object per line (``{"event": ...}``) and exits 0 when the scenar
 
 Scenarios:
 
-* ``observe``: connect, step until a scan and an RGB-D frame were observed, report them (the
+* ``observe``: connect, step until a scan and an RGB-D frame were observed (with ``--truth``:
+  and the truth's robot and people, which come on topics of their own), report them (the
   scan's ranges and points, the leg detector's and the person detector's results), the pose,
   head, odometry, collisions, truth, the step times; then command out of limits, point the head
   out of limits, navigate without a server, close.
@@ -57,8 +58,8 @@ def finite(v: float) -> float | None:
     return float(v) if math.isfinite(v) else None
 
 
-def observe(robot: HsrRobot) -> None:
-    scan = frame = None
+def observe(robot: HsrRobot, want_truth: bool = False) -> None:
+    scan = frame = truth = None
     times = [robot.time]
     for _ in range(60):
         robot.step()
@@ -70,14 +71,16 @@ def observe(robot: HsrRobot) -> None:
             scan, scan_obs = obs.scan, obs
         if obs.rgbd is not None and frame is None:
             frame = obs.rgbd
-        if scan is not None and frame is not None and len(times) > 6:
+        truth = robot.ground_truth()
+        truth_in = not want_truth or (truth is not None and len(truth.people) > 0)
+        if scan is not None and frame is not None and truth_in and len(times) > 6:
             break
     assert scan is not None and frame is not None, "no scan or no frame observed"
+    assert truth_in, "no ground truth of the robot and the people observed"
     legs = LegDetector(load_leg_model()).detect(scan)
     fov = FieldOfView.from_scan(scan)
     detector = robot.person_detector()
     people = detector.detect(frame) if detector is not None else []
-    truth = robot.ground_truth()
     say(
         "observed",
         times=times,
@@ -253,6 +256,7 @@ def main() -> None:
     parser.add_argument("--keypoints", default=None, help="backend.hsr.person_keypoints")
     parser.add_argument("--frames", type=int, default=10, help="frames to observe (people)")
     parser.add_argument("--periods", type=int, default=10, help="periods to observe (scans)")
+    parser.add_argument("--truth", action="store_true", help="observe: wait for the truth too")
     parser.add_argument(
         "--interrupt-at-command",
         type=int,
@@ -280,7 +284,7 @@ def main() -> None:
     say("connected", seconds=time.monotonic() - started, node=robot.node)
     with robot:
         {
-            "observe": observe,
+            "observe": lambda r: observe(r, args.truth),
             "drive": drive,
             "navigate": navigate,
             "connect": lambda r: None,
