@@ -764,6 +764,16 @@ class TargetIdentifier:
             return  # someone else near who may be her too (her clothes, or not seen yet)
         self._named, self._named_once = track_id, True
 
+    def _handoff_open(self) -> bool:
+        """Whether the hand-off may still name her: it is on, nobody was named yet, and no
+        camera frame has come ``handoff_s`` after the first (nor any frame at all)."""
+        p = self.params
+        if p.handoff_s <= 0 or self._named_once:
+            return False
+        return self._last_frame - self._first_frame <= p.handoff_s + STAMP_EPS or not math.isfinite(
+            self._first_frame
+        )
+
     def _may_be_her(self, track_id: int) -> bool:
         """Whether a track may be her as far as the hand-off knows: not known to be someone
         else — a distractor, a face not hers, or clothes not hers in the median of at least
@@ -976,8 +986,10 @@ class TargetIdentifier:
         legs, not named, not decided NOT_TARGET, whose clothes match hers (so only a face can
         tell: a look-alike may be about, or it is not confirmed yet), not known to be someone
         else, its face not yet seen; the most recently seen first. None when she is named, or
-        no one is ambiguous."""
-        if self.target_track() is not None:
+        no one is ambiguous, or while the hand-off may still name her (:meth:`_hand_off`: the
+        robot does not drive up to the person it is being shown; traced, house seeds 27 and
+        48: the search drove toward her at 0.1 s, before the hand-off named her at 0.2 s)."""
+        if self.target_track() is not None or self._handoff_open():
             return None
         p = self.params
         best: tuple[float, int] | None = None

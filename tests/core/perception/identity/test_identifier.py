@@ -454,14 +454,19 @@ def test_her_face_on_another_track_takes_the_name_from_a_track_with_older_faces(
 
 def test_someone_in_her_clothes_without_a_face_is_the_candidate_to_go_and_see(learned) -> None:
     """While she is not named, a track in her clothes whose face has not been seen is offered
-    for the go-and-see-the-face leaf; one in other clothes or known by face is not."""
+    for the go-and-see-the-face leaf; one in other clothes or known by face is not. Not while
+    the hand-off (``handoff_s`` from the first frame) may still name her."""
     profile, params, encoder = learned
     ident = TargetIdentifier(profile, params, encoder)
     ident.observe(2, 0.0, True, *_at(_picture(RED, OTHER_FACE), 5.0, 5.0))  # a look-alike
     ident.observe(3, 0.1, True, *_at(_picture(GREEN, None), 2.0, -2.0))
     ident.observe(4, 0.1, True, *_at(_picture(RED, None), 2.0, 2.0))
+    assert ident.candidate_track() is None  # the hand-off's window
+    late = params.handoff_s + 0.1
+    ident.observe(4, late, True, *_at(_picture(RED, None), 2.0, 2.0))
     assert ident.candidate_track() == 4
-    assert ident.observe(4, 0.2, True, *_at(_picture(RED, TARGET_FACE), 2.0, 2.0)).basis == "face"
+    face = _at(_picture(RED, TARGET_FACE), 2.0, 2.0)
+    assert ident.observe(4, late + 0.1, True, *face).basis == "face"
     assert ident.target_track() == 4 and ident.candidate_track() is None
 
 
