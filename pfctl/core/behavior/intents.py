@@ -7,7 +7,8 @@ tick's final intents into calls on the Robot port. What a leaf can ask for:
 
 - the base: :meth:`Intents.follow` (TURN / GO_STRAIGHT / MOVE_BASE of
   :class:`~pfctl.core.control.BaseController`), :meth:`Intents.go_to` (MOVE_BASE to a goal moved
-  into free space, sent again only when it moved), :meth:`Intents.turn` and
+  into free space, sent again only when it moved; stepping aside for a person who waits for the
+  robot, :mod:`~pfctl.core.behavior.give_way`), :meth:`Intents.turn` and
   :meth:`Intents.stop`; an action that drove the base gives it up with :meth:`Intents.release`;
 - the head: :meth:`Intents.look_at` (a point) or :meth:`Intents.set_pan` (joint angles); a tick
   in which no leaf pointed the head gets the gaze rule's (:func:`~pfctl.core.control.gaze_rule`).
@@ -29,6 +30,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from pfctl.core.behavior.give_way import GiveWay
 from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import BaseController, ControlParams
 from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
@@ -145,11 +147,14 @@ class Intents:
         self.base_claimed = False
         """A leaf drove the base this tick."""
         self.base_mode = "stop"
-        """What the base does this tick, for the log (:data:`~pfctl.core.control.MODES`)."""
+        """What the base does this tick, for the log (:data:`~pfctl.core.control.MODES`, or
+        ``give_way``)."""
         self.head: list[HeadIntent] = []
         """The head intents of this tick, in the order they were written."""
         self._laws: dict[float, BaseController] = {}
         """The base control law for each following distance a leaf asked for."""
+        self.give_way = GiveWay()
+        """When the robot, driving to a goal, steps aside for a person waiting for it."""
 
     # -- tick bookkeeping -------------------------------------------------------------------------
 
@@ -261,9 +266,14 @@ class Intents:
             return self._arrived()
         goal = self.world.free_goal(xy)
         if goal is None:
+            self.give_way.done()
             return "failed"
         if math.dist(here, goal) <= tolerance:
             return self._arrived()
+        world = self.world
+        aside = self.give_way.check(self.now, here, world.people_xy, world.planner)
+        if aside is not None:
+            return self._step_aside(aside)
         nav = self.navigation
         theta = face if face is not None else math.atan2(goal[1] - here[1], goal[0] - here[0])
         resend = nav.goal is None or math.dist(nav.goal, goal) > RESEND_DISTANCE
@@ -272,6 +282,7 @@ class Intents:
                 return self._arrived()
             if nav.status is NavStatus.ABORTED:
                 nav.goal = None
+                self.give_way.done()
                 return "failed"
             if nav.status in (NavStatus.PREEMPTED, NavStatus.IDLE):
                 resend = True
@@ -284,7 +295,27 @@ class Intents:
         if self.navigation.goal is not None:
             self._write(CancelGoal())
         self.base_mode = "hold"
+        self.give_way.done()
         return "arrived"
+
+    def _step_aside(self, aside: tuple[float, float]) -> str:
+        """MOVE_BASE to ``aside`` out of a waiting person's way, keeping the heading, and hold
+        there (:mod:`~pfctl.core.behavior.give_way`); the goal is still ``running``. Where the
+        robot cannot get there, or its MOVE_BASE stops short, it holds where it is."""
+        nav = self.navigation
+        here = (self.pose.x, self.pose.y)
+        self.base_mode = "give_way"
+        sent = nav.goal is not None and math.dist(nav.goal, aside) <= 1e-6
+        if sent and nav.status in (NavStatus.ABORTED, NavStatus.SUCCEEDED):
+            nav.goal = None
+            aside = self.give_way.hold(here)
+        if math.dist(here, aside) <= GiveWay.ARRIVED:
+            if nav.goal is not None:
+                self._write(CancelGoal())
+            return "running"
+        if not sent or nav.status in (NavStatus.PREEMPTED, NavStatus.IDLE):
+            self._write(Navigate(Pose2D(aside[0], aside[1], self.pose.theta)))
+        return "running"
 
     def release(self) -> None:
         """A leaf that drove the base stops doing so (it was preempted or finished)."""

@@ -1,0 +1,151 @@
+"""Giving way to a person who waits for the robot (a doorway, a narrow hall).
+
+A MOVE_BASE goal stops the base while a person stands on its path, and a person stops when the
+robot is in theirs: in a doorway both wait, for good. Traced, the shipped house (issue 8's
+randomized campaign, seeds 12 and 14): two people going out of the office stood in its door
+from 27 s to the end of the episode, the robot waiting in front of them to go in, and the
+target stood unseen behind the office's bookshelf. People resolve this by one of them stepping
+aside; the robot does.
+
+:class:`GiveWay` watches the robot drive to its goals (:meth:`GiveWay.check`, called by
+:meth:`~pfctl.core.behavior.intents.Intents.go_to` each tick). When the robot has made no
+progress (``PROGRESS`` m) for ``AFTER_S`` seconds with a person within ``NEAR`` m, it steps
+``STEP`` m out of that person's way — to the side first, off the line from them through the
+robot (the way they want to go, as far as the robot can tell), else back — along a straight line
+that is free on the static map, and holds there until ``FOR_S`` seconds have passed since its
+last step; then it drives on to its goal. When the person comes on its way there (traced, seed
+14: its diagonal step back was where he was going), it steps aside again, a few times at most.
+The robot's MOVE_BASE keeps its own recovery (re-plan, abort); giving way adds the one thing it
+cannot do, moving off the goal's path.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from pfctl.core.mapping.planning import GridPlanner
+
+XY = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Yielding:
+    """Giving way since ``since`` (s), at the place ``to``, from the person at ``person``;
+    the ``steps``-th step aside in a row."""
+
+    since: float
+    to: XY
+    person: XY
+    steps: int = 1
+
+
+class GiveWay:
+    """When and where to give way (module docstring), across ticks."""
+
+    #: No progress of this much, m, ...
+    PROGRESS = 0.2
+    #: ... for this long, s, with a person this near, m, gives way.
+    AFTER_S = 3.0
+    NEAR = 1.0
+    #: The step out of the way, m; the place must be at least ``CLEAR`` m from every person.
+    STEP = 1.0
+    CLEAR = 0.8
+    #: Giving way (the step and the wait there) lasts this long, s, from the last step.
+    FOR_S = 5.0
+    #: The robot is at its place this close to it, m; a person still within ``CLEAR`` m this
+    #: long after a step gets another, up to ``STEPS`` in a row.
+    ARRIVED = 0.15
+    SETTLE_S = 1.0
+    STEPS = 3
+    #: A go-to not asked for this long, s, starts the progress clock afresh.
+    GAP_S = 0.5
+
+    def __init__(self) -> None:
+        self.yielding: Yielding | None = None
+        """Giving way now (None: not)."""
+        self._progress: tuple[float, XY] | None = None
+        """When and where the robot last made progress toward a goal."""
+        self._asked_at = -math.inf
+
+    def check(self, now: float, here: XY, people: ArrayLike, planner: GridPlanner) -> XY | None:
+        """The place to give way at this tick (None: drive on to the goal): called on every
+        tick the robot drives to a goal, at time ``now`` and position ``here``, with the
+        other people's positions ``(n, 2)`` and the static map's ``planner``. A person still
+        within ``CLEAR`` m once the robot stands at its place (they came on its way) gets a
+        step aside from there too, up to ``STEPS`` in all."""
+        gap = now - self._asked_at > self.GAP_S
+        self._asked_at = now
+        pts = np.asarray(people, dtype=float).reshape(-1, 2)
+        y = self.yielding
+        if y is not None and not gap and now - y.since < self.FOR_S:
+            there = math.dist(here, y.to) <= self.ARRIVED
+            if there and y.steps < self.STEPS and now - y.since >= self.SETTLE_S:
+                again = self._step(now, here, pts, planner, self.CLEAR, y.steps + 1)
+                if again is not None:
+                    return again
+            return y.to
+        if y is not None or gap:
+            self.yielding = None
+            self._progress = (now, here)
+            return None
+        p = self._progress
+        if p is None or math.dist(here, p[1]) > self.PROGRESS:
+            self._progress = p = (now, here)
+        if now - p[0] < self.AFTER_S:
+            return None
+        return self._step(now, here, pts, planner, self.NEAR, 1)
+
+    def _step(
+        self, now: float, here: XY, people: np.ndarray, planner: GridPlanner, near: float, n: int
+    ) -> XY | None:
+        """Give way to the nearest person within ``near`` m (the ``n``-th step): the place."""
+        if len(people) == 0:
+            return None
+        d = np.hypot(people[:, 0] - here[0], people[:, 1] - here[1])
+        k = int(np.argmin(d))
+        if d[k] > near:
+            return None
+        person = (float(people[k, 0]), float(people[k, 1]))
+        to = self.place(here, person, people, planner)
+        if to is None:
+            return None
+        self.yielding = Yielding(now, to, person, n)
+        return to
+
+    def place(self, here: XY, person: XY, people: np.ndarray, planner: GridPlanner) -> XY | None:
+        """Where to step out of ``person``'s way: ``STEP`` m from ``here`` to either side, then
+        diagonally back, then straight back (away from them), the first place farthest from
+        the line from them through the robot, reached in a straight line free on the static
+        map, and ``CLEAR`` m from everyone; None when there is no such place."""
+        u = np.array([here[0] - person[0], here[1] - person[1]])
+        norm = float(np.linalg.norm(u))
+        u = u / norm if norm > 1e-9 else np.array([1.0, 0.0])
+        n = np.array([-u[1], u[0]])
+        best: tuple[float, XY] | None = None
+        for direction in (n, -n, (u + n) / math.sqrt(2), (u - n) / math.sqrt(2), u):
+            to = np.asarray(here) + self.STEP * direction
+            line = np.linspace(here, to, 21)
+            if not planner.free_mask(line[1:]).all():
+                continue
+            if np.min(np.hypot(people[:, 0] - to[0], people[:, 1] - to[1])) < self.CLEAR:
+                continue
+            off_line = abs(float(np.dot(to - np.asarray(person), n)))
+            if best is None or off_line > best[0] + 1e-6:
+                best = (off_line, (float(to[0]), float(to[1])))
+        return None if best is None else best[1]
+
+    def hold(self, here: XY) -> XY:
+        """The robot cannot get to the place (or its MOVE_BASE stopped short): give way where it
+        is for the rest of the time; the place to be at."""
+        if self.yielding is not None:
+            self.yielding = replace(self.yielding, to=here)
+        return here
+
+    def done(self) -> None:
+        """The goal was reached or given up: the next goal starts the clock afresh."""
+        self.yielding = None
+        self._progress = None

@@ -1,0 +1,106 @@
+"""Giving way (no robot): a robot driving to a goal that makes no progress with a person close in
+front steps aside, out of the line from them through the robot, holds there, and drives on; it
+steps again when they come its way; a robot stuck with nobody about, or still moving, does not.
+The place is the office door of ``missions/house.yaml`` (house seed 14's deadlock)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from pfctl.core.behavior.give_way import GiveWay
+from pfctl.core.behavior.intents import Intents, Navigate
+from pfctl.core.behavior.world import WorldModel
+from pfctl.core.control import ControlParams
+from pfctl.core.mapping.grid import OccupancyGrid
+from pfctl.core.mapping.house import HouseLayout
+from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.regions import RegionMap, SearchParams
+from pfctl.core.robot import NavStatus, Pose2D
+
+DOOR = (3.9, 6.1)  # the robot, in the office's door, going in
+WAITING = (3.9, 6.6)  # a person inside, waiting to come out
+GOAL = (2.6, 7.8)  # inside the office
+
+
+@pytest.fixture
+def intents(planner: GridPlanner, layout: HouseLayout) -> Intents:
+    grid = OccupancyGrid(planner.geometry)
+    world = WorldModel(grid, planner, RegionMap(layout), SearchParams())
+    return Intents(ControlParams(), world)
+
+
+def _go(
+    intents: Intents, t: float, xy: tuple[float, float], people: list[tuple[float, float]]
+) -> str:
+    """One tick at ``t`` with the robot at ``xy`` and ``people`` tracked, driving to GOAL."""
+    status = NavStatus.ACTIVE if intents.navigation.goal is not None else NavStatus.IDLE
+    intents.navigation.status = status
+    intents.begin(t, Pose2D(xy[0], xy[1], math.pi / 2))
+    intents.world.update(t, people)
+    return intents.go_to(GOAL, tolerance=0.4)
+
+
+def _stuck(intents: Intents, people: list[tuple[float, float]], until: float) -> float:
+    """Tick every 0.1 s with the robot standing in the door until it gives way (or ``until``
+    s); the time of that tick."""
+    t = 0.0
+    while t <= until + 1e-9:
+        assert _go(intents, t, DOOR, people) == "running"
+        if intents.base_mode == "give_way":
+            break
+        t += 0.1
+    return t
+
+
+def test_a_robot_stuck_before_a_waiting_person_steps_aside_then_drives_on(
+    intents: Intents, planner: GridPlanner
+) -> None:
+    t = _stuck(intents, [WAITING], until=2 * GiveWay.AFTER_S)
+    assert t == pytest.approx(GiveWay.AFTER_S)
+    sent = intents.base
+    assert isinstance(sent, Navigate)
+    aside = (sent.goal.x, sent.goal.y)
+    assert math.dist(aside, DOOR) == pytest.approx(GiveWay.STEP)
+    assert math.dist(aside, WAITING) >= GiveWay.CLEAR
+    assert abs(aside[0] - DOOR[0]) > 0.5  # off the line from them through the robot
+    line = np.linspace(DOOR, aside, 50)
+    assert planner.free_mask(line).all()  # a straight way there on the static map
+    since = t
+    t += 0.1
+    _go(intents, t, aside, [WAITING])  # there: it holds, the person walks by
+    assert intents.base_mode == "give_way" and intents.navigation.goal is None
+    passed = (2.6, 4.8)  # out of the door and off down the hall
+    while t < since + GiveWay.FOR_S - 0.15:
+        t += 0.1
+        assert _go(intents, t, aside, [passed]) == "running"
+        assert intents.base_mode == "give_way"
+    t += 0.2
+    assert _go(intents, t, aside, [passed]) == "running"
+    assert intents.base_mode == "move_base" and isinstance(intents.base, Navigate)
+    assert (intents.base.goal.x, intents.base.goal.y) == pytest.approx(GOAL, abs=0.1)
+
+
+def test_a_person_coming_its_way_gets_another_step_aside(intents: Intents) -> None:
+    t = _stuck(intents, [WAITING], until=2 * GiveWay.AFTER_S)
+    assert isinstance(intents.base, Navigate)
+    first = (intents.base.goal.x, intents.base.goal.y)
+    after = t + GiveWay.SETTLE_S + 0.1
+    toward = (first[0], first[1] + 0.5)  # he came on to where the robot stepped
+    while t < after:
+        t += 0.1
+        _go(intents, t, first, [toward])
+    y = intents.give_way.yielding
+    assert y is not None and y.steps == 2 and math.dist(y.to, first) == pytest.approx(1.0)
+    assert math.dist(y.to, toward) >= GiveWay.CLEAR
+
+
+def test_no_step_aside_with_nobody_near_or_while_the_robot_moves(intents: Intents) -> None:
+    _stuck(intents, [(8.0, 2.0)], until=2 * GiveWay.AFTER_S)  # the nearest: across the house
+    assert intents.base_mode == "move_base" and intents.give_way.yielding is None
+    for k in range(round(2 * GiveWay.AFTER_S / 0.1)):
+        xy = (DOOR[0] - 0.01 * k, DOOR[1] + 0.01 * k)  # slowly, but on its way
+        _go(intents, 100.0 + 0.1 * k, xy, [(xy[0], xy[1] + 0.6)])
+        assert intents.base_mode == "move_base"
