@@ -412,6 +412,10 @@ class WaypointSearch(Action):
     #: distance, m (a place at a door's edge is a few centimetres from one behind its jamb).
     APPROACH_REPLAN_S: ClassVar[float] = 1.0
     APPROACH_TOLERANCE: ClassVar[float] = 0.1
+    #: Once there, a place chosen again within this distance, m, is not driven to (MOVE_BASE
+    #: stops within its own tolerance, and each new goal then stopped at once: traced, house
+    #: seed 12, the base went and stopped on alternate ticks for a second).
+    APPROACH_KEEP: ClassVar[float] = 0.25
 
     def initialise(self) -> None:
         self._start = self.t
@@ -430,6 +434,8 @@ class WaypointSearch(Action):
         """Candidates gone up to, and when that began."""
         self._approach_place: tuple[int, float, tuple[float, float]] | None = None
         """The candidate's track, when its place to be seen from was chosen, and the place."""
+        self._approach_reached: tuple[float, float] | None = None
+        """The place to see a candidate from that the robot last reached."""
 
     def _approach_candidate(self) -> bool:
         """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
@@ -465,12 +471,17 @@ class WaypointSearch(Action):
             place = self._approach_place = (c.track_id, self.t, found.xy)
         self.intents.look_at(c.xy, "candidate")  # the torso: the whole person and the face in view
         goal = place[2]
+        there = self._approach_reached
+        if there is not None and math.dist(there, goal) <= self.APPROACH_KEEP:
+            self.intents.stop()  # there already: a new place this near is not driven to
+            return True
         facing = math.atan2(c.y - goal[1], c.x - goal[0])
         outcome = self.intents.go_to(goal, self.APPROACH_TOLERANCE, facing)
         if outcome == "failed":
             self._approached[c.track_id] = -math.inf  # no way there: on with the search
             return False
         if outcome == "arrived":
+            self._approach_reached = goal
             self.intents.stop()
         return True
 

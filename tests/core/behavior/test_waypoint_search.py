@@ -59,6 +59,12 @@ def test_a_standing_candidate_is_gone_up_to_head_on_them_then_left_after_a_while
     rig.intents.nav = "arrived"
     assert rig.approach(5.0, her, Pose2D(*goal)) and rig.stops == 1
     assert rig.intents.looks[-1][1] == "candidate"
+    # its MOVE_BASE stopped a few centimetres short: the place chosen again is not driven to
+    rig.intents.nav = "running"
+    sent = len(rig.intents.goals)
+    short = Pose2D(goal[0] - 0.12, goal[1])
+    assert rig.approach(5.0 + WaypointSearch.APPROACH_REPLAN_S, her, short) and rig.stops == 2
+    assert len(rig.intents.goals) == sent
     # her face never turned to the robot: after approach_s the search goes on past her
     assert not rig.approach(APPROACH_S + 0.1, her, Pose2D(*goal))
     someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
