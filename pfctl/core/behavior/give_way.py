@@ -34,12 +34,11 @@ XY = tuple[float, float]
 
 @dataclass(frozen=True)
 class Yielding:
-    """Giving way since ``since`` (s), at the place ``to``, from the person at ``person``;
-    the ``steps``-th step aside in a row."""
+    """Giving way since ``since`` (s), at the place ``to``: the ``steps``-th step aside in a
+    row."""
 
     since: float
     to: XY
-    person: XY
     steps: int = 1
 
 
@@ -113,7 +112,7 @@ class GiveWay:
         to = self.place(here, person, people, planner)
         if to is None:
             return None
-        self.yielding = Yielding(now, to, person, n)
+        self.yielding = Yielding(now, to, n)
         return to
 
     def place(self, here: XY, person: XY, people: np.ndarray, planner: GridPlanner) -> XY | None:

@@ -770,9 +770,9 @@ class TargetIdentifier:
         p = self.params
         if p.handoff_s <= 0 or self._named_once:
             return False
-        return self._last_frame - self._first_frame <= p.handoff_s + STAMP_EPS or not math.isfinite(
-            self._first_frame
-        )
+        if not math.isfinite(self._first_frame):
+            return True
+        return self._last_frame - self._first_frame <= p.handoff_s + STAMP_EPS
 
     def _may_be_her(self, track_id: int) -> bool:
         """Whether a track may be her as far as the hand-off knows: not known to be someone
