@@ -469,12 +469,14 @@ class HsrRobot:
         )
         return None if ok else str(error).strip().rstrip(".")
 
-    def _missing(self, published: set[str]) -> list[str]:
+    def _missing(self, published: set[str] | None) -> list[str]:
+        """What the robot has not sent yet that the follower needs; ``published``: the topics
+        the master lists (None: it has not answered yet, so no topic is said to be unpublished)."""
         cfg = self.config
         missing = []
 
         def no(what: str, topic: str) -> str:
-            hint = "" if topic in published else " (no node publishes it)"
+            hint = "" if published is None or topic in published else " (no node publishes it)"
             return f"no {what} on {topic}{hint}"
 
         if self.use_sim_time and self._clock_wall is None:
@@ -516,7 +518,8 @@ class HsrRobot:
         deadline = time.monotonic() + timeout
         published: set[str] = set()
         next_query = 0.0
-        missing = ["the list of topics from the master"]
+        # interrupted before the master's first answer: what is missing all the same
+        missing = [*self._missing(None), "the list of topics from the master"]
         pending: list[str] = []
         looked_again = False
         try:
