@@ -25,7 +25,7 @@ from pfctl.commands import replay as replay_command
 from pfctl.commands import sim as sim_commands
 from pfctl.commands import track as track_commands
 from pfctl.errors import UserError
-from pfctl.interrupts import Interrupted, command_signals, unreported
+from pfctl.interrupts import Interrupted, behind, command_signals, unreported
 
 app = typer.Typer(
     name="pfctl",
@@ -103,7 +103,8 @@ def _usage_line(err: ClickException) -> str:
 
 def main() -> None:
     """Console entry point: user errors become one line on stderr and exit status 2; SIGINT and
-    SIGTERM (:mod:`pfctl.interrupts`) one line and exit status 130 or 143."""
+    SIGTERM (:mod:`pfctl.interrupts`) one line and exit status 130 or 143, also when the
+    signal's exception surfaced as another (:func:`pfctl.interrupts.behind`)."""
     with command_signals(ending=True):
         try:
             _run_app()
@@ -116,6 +117,12 @@ def main() -> None:
                 if isinstance(end, SystemExit):
                     raise
                 interrupt = Interrupted(signal.SIGINT)
+            sys.stderr.write(interrupt.line())
+            sys.exit(interrupt.exit_status)
+        except Exception as err:
+            interrupt = behind(err)
+            if interrupt is None:
+                raise
             sys.stderr.write(interrupt.line())
             sys.exit(interrupt.exit_status)
 

@@ -167,6 +167,22 @@ def unreported(end: BaseException) -> Interrupted | None:
     return _state.raised
 
 
+def behind(err: BaseException) -> Interrupted | None:
+    """The :class:`Interrupted` that ``err`` was raised from or while handling, if any.
+
+    A signal's exception can surface as another one: a native extension whose import it cut
+    short (dlib's pybind11 module) raises ``ImportError: initialization failed`` from it. The
+    command still ends as interrupted, not with the other exception's traceback."""
+    seen: set[int] = set()
+    link: BaseException | None = err
+    while link is not None and id(link) not in seen:
+        if isinstance(link, Interrupted):
+            return link
+        seen.add(id(link))
+        link = link.__cause__ or link.__context__
+    return None
+
+
 @contextlib.contextmanager
 def graceful_interrupts() -> Iterator[StopFlag]:
     """Open a run: from now until the command ends, the first SIGINT or SIGTERM sets the flag
@@ -195,6 +211,7 @@ __all__ = [
     "HANDLED",
     "Interrupted",
     "StopFlag",
+    "behind",
     "command_signals",
     "exit_status",
     "graceful_interrupts",

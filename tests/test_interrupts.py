@@ -7,7 +7,8 @@ import signal
 
 import pytest
 
-from pfctl.interrupts import Interrupted, command_signals, graceful_interrupts
+from pfctl import cli
+from pfctl.interrupts import Interrupted, behind, command_signals, graceful_interrupts
 
 
 def _kill(signum: int) -> None:
@@ -73,3 +74,43 @@ def test_a_signal_ignored_at_start_stays_ignored() -> None:
             assert not stop()
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def _import_cut_short_by(signum: int) -> None:
+    """What a native extension's import does when a signal's exception cuts its module's
+    initialisation short (dlib's pybind11 module): it raises an ImportError from it."""
+    try:
+        _kill(signum)
+    except Interrupted as err:
+        raise ImportError("initialization failed") from err
+
+
+def test_a_signal_that_surfaced_as_another_exception_is_found_behind_it() -> None:
+    with command_signals(), pytest.raises(ImportError) as raised:
+        _import_cut_short_by(signal.SIGTERM)
+    found = behind(raised.value)
+    assert found is not None and found.signum == signal.SIGTERM
+    assert behind(ImportError("no module named dlib")) is None
+
+
+def test_the_command_ends_as_interrupted_when_the_signal_surfaced_as_another_exception(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """CI once sent SIGTERM while ``follow`` imported dlib: the command ended with the
+    ImportError's traceback and status 1 instead of its one line and 143."""
+    monkeypatch.setattr(cli, "_run_app", lambda: _import_cut_short_by(signal.SIGTERM))
+    with pytest.raises(SystemExit) as ended:
+        cli.main()
+    assert ended.value.code == 143
+    assert capsys.readouterr().err == "pfctl: interrupted (SIGTERM)\n"
+
+
+def test_an_exception_without_a_signal_behind_it_is_not_taken_for_one(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    def fails() -> None:
+        raise ImportError("initialization failed")
+
+    monkeypatch.setattr(cli, "_run_app", fails)
+    with pytest.raises(ImportError):
+        cli.main()
