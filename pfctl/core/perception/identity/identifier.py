@@ -84,12 +84,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from pfctl.core.perception.clothes import convert, histogram_intersection
+from pfctl.core.perception.clothes import convert
 from pfctl.core.perception.faces import Box, Face, FaceEncoder
 from pfctl.core.perception.identity.distractors import DistractorMemory
 from pfctl.core.perception.identity.log_odds import Cues, log_odds
 from pfctl.core.perception.identity.params import IdentityParams
-from pfctl.core.perception.identity.profile import Appearance, TargetProfile, describe, face_region
+from pfctl.core.perception.identity.profile import (
+    Appearance,
+    TargetProfile,
+    clothes_similarity,
+    describe,
+    face_region,
+)
 from pfctl.core.perception.vision import PersonDetection
 
 if TYPE_CHECKING:
@@ -159,6 +165,10 @@ class TrackIdentity:
     this observation's frame; with a worker: in the frame the search was submitted from)."""
     log_odds: float = 0.0
     """The belief that the track is the target (:mod:`~pfctl.core.perception.identity.log_odds`)."""
+    clothes_relit: float | None = None
+    """The relit clothes similarity (the same clothes under other light,
+    :func:`~pfctl.core.perception.clothes.relit_intersection`), as ``clothes_similarity``: only
+    it says that clothes are *not* hers."""
 
 
 @dataclass
@@ -167,6 +177,8 @@ class _Evidence:
     last_face: float = -math.inf
     """Stamp of the frame of the newest face sample."""
     clothes: list[float] = field(default_factory=list)
+    clothes_relit: list[float] = field(default_factory=list)
+    """The relit similarity of each of ``clothes``' samples."""
     observations: int = 0
     legs_seen: int = 0
     last_seen: float = -math.inf
@@ -200,8 +212,8 @@ class _Evidence:
     unlike_since: float = math.inf
     """Since when the track's clothes have been clearly unlike hers (inf: they are not)."""
     clear_clothes: list[float] = field(default_factory=list)
-    """Clothes samples taken while no other person's box overlapped this one's (a person half
-    hidden behind another shows partly the other's clothes)."""
+    """Relit clothes samples taken while no other person's box overlapped this one's (a person
+    half hidden behind another shows partly the other's clothes)."""
 
     def face(self, recent: int) -> float | None:
         """The median distance of the newest ``recent`` face samples (None: no face yet): a
@@ -217,6 +229,12 @@ class _Evidence:
         if not self.clothes:
             return None
         return float(np.median(self.clothes[-recent:]))
+
+    def relit_now(self, recent: int) -> float | None:
+        """:meth:`clothes_now` of the relit similarities."""
+        if not self.clothes_relit:
+            return None
+        return float(np.median(self.clothes_relit[-recent:]))
 
 
 @dataclass(frozen=True)
@@ -405,7 +423,7 @@ class TargetIdentifier:
                 ev.last_clothes = t
                 self.face_stats.clothes_measured += 1
                 if len(ev.clothes) > measured and not _overlapped(detection, sightings):
-                    ev.clear_clothes.append(ev.clothes[-1])
+                    ev.clear_clothes.append(ev.clothes_relit[-1])
             wanted = [
                 (ev.last_search, k)
                 for k, (_, ev, detection) in enumerate(seen)
@@ -475,25 +493,21 @@ class TargetIdentifier:
         s = self.profile.similarity(appearance)
         if s is None:
             return
+        relit = self.profile.similarity(appearance, relit=True)
+        assert relit is not None
         if self._online is not None:
-            online = self._similarity_online(appearance)
+            clothes = self.profile.clothes
+            online = clothes_similarity(appearance, self._online, clothes)
+            online_relit = clothes_similarity(appearance, self._online, clothes, relit=True)
             s = s if online is None else max(s, online)
+            relit = relit if online_relit is None else max(relit, online_relit)
         first = not ev.clothes
         ev.clothes.append(s)
+        ev.clothes_relit.append(max(s, relit))
         ev.upper = appearance.upper if appearance.upper is not None else ev.upper
         ev.lower = appearance.lower if appearance.lower is not None else ev.lower
         if first and ev.xy is not None and ev.distractor is None:
             self._link(ev, t)
-
-    def _similarity_online(self, appearance: Appearance) -> float | None:
-        """Clothes similarity to her online appearance model (as the profile's)."""
-        assert self._online is not None
-        s = [
-            histogram_intersection(h, m)
-            for h, m in ((appearance.upper, self._online[0]), (appearance.lower, self._online[1]))
-            if h is not None
-        ]
-        return min(s) if s else None
 
     def _link(self, ev: _Evidence, t: float) -> None:
         """A new track first measured: is it a remembered distractor (item 4)?"""
@@ -609,8 +623,9 @@ class TargetIdentifier:
     def _decide(self, track_id: int, ev: _Evidence, face_box: Box | None) -> TrackIdentity:
         p = self.params
         clothes = ev.clothes_now(p.clothes_recent)
+        relit = ev.relit_now(p.clothes_recent)
         now = ev.last_seen
-        self._check_unlike(ev, clothes, now)  # before the faces: it may forget them
+        self._check_unlike(ev, relit, now)  # before the faces: it may forget them
         face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
         if face_d is not None and face_d >= p.face_distance:
@@ -623,6 +638,7 @@ class TargetIdentifier:
         cues = Cues(
             face_distance=face_d,
             clothes_similarity=clothes,
+            clothes_relit=relit,
             look_alike_about=self._look_alike_about(track_id, now),
             distractor=ev.distractor is not None,
             named=track_id == self._named,
@@ -651,6 +667,7 @@ class TargetIdentifier:
             face_distance=face_d,
             best_face_distance=best,
             clothes_similarity=clothes,
+            clothes_relit=relit,
             face_samples=len(ev.face_distances),
             clothes_samples=len(ev.clothes),
             observations=ev.observations,
@@ -661,10 +678,11 @@ class TargetIdentifier:
         )
 
     def _check_unlike(self, ev: _Evidence, clothes: float | None, now: float) -> None:
-        """A track whose clothes turn clearly unlike hers (``clothes_margin`` below the
-        threshold) has slid onto someone else (the tracker swapped it in a crowd): the faces of
-        hers it showed before are not this person's, so they are forgotten, and a name it holds
-        goes at once unless her face is seen on it again (:meth:`_doubted`)."""
+        """A track whose clothes turn clearly unlike hers (``clothes``: the relit similarity,
+        ``clothes_margin`` below the threshold) has slid onto someone else (the tracker swapped
+        it in a crowd): the faces of hers it showed before are not this person's, so they are
+        forgotten, and a name it holds goes at once unless her face is seen on it again
+        (:meth:`_doubted`)."""
         p = self.params
         unlike = clothes is not None and clothes < p.clothes_similarity - p.clothes_margin
         if not unlike:
@@ -983,8 +1001,9 @@ class TargetIdentifier:
 
     def candidate_track(self) -> int | None:
         """An ambiguous person worth going to see the face of (issue 23, item 3): a track with
-        legs, not named, not decided NOT_TARGET, whose clothes match hers (so only a face can
-        tell: a look-alike may be about, or it is not confirmed yet), not known to be someone
+        legs, not named, not decided NOT_TARGET, whose clothes match hers under this light or
+        another (the relit similarity; so only a face can tell: a look-alike may be about, it is
+        not confirmed yet, or the light is not the one she was learned in), not known to be someone
         else, its face not yet seen; the most recently seen first. None when she is named, or
         no one is ambiguous, or while the hand-off may still name her (:meth:`_hand_off`: the
         robot does not drive up to the person it is being shown; traced, house seeds 27 and
@@ -1000,8 +1019,8 @@ class TargetIdentifier:
                 and ident.legs_seen
                 and not ev.face_distances
                 and ev.distractor is None
-                and ident.clothes_similarity is not None
-                and ident.clothes_similarity >= p.clothes_similarity
+                and ident.clothes_relit is not None
+                and ident.clothes_relit >= p.clothes_similarity
                 and (best is None or ident.last_seen > best[0])
             ):
                 best = (ident.last_seen, tid)

@@ -7,10 +7,12 @@ each cue says, weighted by how reliable it is (:class:`LogOddsWeights`):
   median distance ``d`` of the track's faces to her profile — a clear match or mismatch
   saturates at ± ``face_weight``;
 - **clothes**: ``clothes_weight × clip((S − clothes_similarity) / clothes_scale, −1, 1)`` for the
-  mean histogram intersection S — but clothes count only as far as they *separate* her from the
-  people about now (Koide & Miura's online discrimination): while a look-alike is about (another
-  person in her clothes is tracked, or was seen lately) matching clothes are no evidence at all;
-  clothes that do not match her still count against;
+  median histogram intersection S — but clothes count only as far as they *separate* her from
+  the people about now (Koide & Miura's online discrimination): while a look-alike is about
+  (another person in her clothes is tracked, or was seen lately) matching clothes are no
+  evidence at all; clothes that do not match her still count against, by the same formula on
+  the *relit* similarity (:func:`~pfctl.core.perception.clothes.relit_intersection`): clothes
+  that match hers under other light are no evidence against her;
 - **distractor**: ``−distractor_weight`` for a track known not to be her without a face of its
   own: a person seen at the same time as her face-confirmed track, away from her (two places at
   once), or a new track linked to a remembered distractor
@@ -51,6 +53,8 @@ class Cues:
     look_alike_about: bool
     distractor: bool
     named: bool
+    clothes_relit: float | None = None
+    """The relit clothes similarity (None: as ``clothes_similarity``)."""
 
 
 def _clip(v: float) -> float:
@@ -71,7 +75,15 @@ def log_odds(
         c = w.clothes_weight * _clip(
             (cues.clothes_similarity - clothes_threshold) / w.clothes_scale
         )
-        parts["clothes"] = 0.0 if c > 0 and cues.look_alike_about else c
+        if c > 0 and cues.look_alike_about:
+            c = 0.0
+        elif c < 0 and cues.clothes_relit is not None:
+            c = min(
+                0.0,
+                w.clothes_weight
+                * _clip((cues.clothes_relit - clothes_threshold) / w.clothes_scale),
+            )
+        parts["clothes"] = c
     if cues.distractor:
         parts["distractor"] = -w.distractor_weight
     if cues.named:

@@ -25,6 +25,7 @@ from pfctl.core.perception.clothes import (
     color_histograms,
     convert,
     histogram_intersection,
+    relit_intersection,
 )
 from pfctl.core.perception.faces import (
     EMBEDDING_SIZE,
@@ -114,6 +115,25 @@ def describe(
     return Appearance(upper, lower, face, face_box)
 
 
+def clothes_similarity(
+    appearance: Appearance,
+    target: tuple[np.ndarray, np.ndarray],
+    params: ClothesParams,
+    relit: bool = False,
+) -> float | None:
+    """Algorithm 2's clothes similarity S of an appearance against her ``(upper, lower)``
+    histograms: the smaller of the two parts' (both must match; a part not seen does not
+    count); None if neither was seen. ``relit``: each part's
+    :func:`~pfctl.core.perception.clothes.relit_intersection` (the same clothes under other
+    light), for evidence that clothes are not hers."""
+    s = [
+        relit_intersection(h, t, params) if relit else histogram_intersection(h, t)
+        for h, t in ((appearance.upper, target[0]), (appearance.lower, target[1]))
+        if h is not None
+    ]
+    return min(s) if s else None
+
+
 # -- the target's profile ------------------------------------------------------------------------
 
 
@@ -141,15 +161,12 @@ class TargetProfile:
             return None
         return float(np.median(face_distance(self.faces, embedding)))
 
-    def similarity(self, appearance: Appearance) -> float | None:
+    def similarity(self, appearance: Appearance, relit: bool = False) -> float | None:
         """Clothes similarity S of an appearance: the smaller of the upper and lower body's
-        (both must match; a part not seen does not count); None if neither was seen."""
-        s = [
-            histogram_intersection(h, t)
-            for h, t in ((appearance.upper, self.upper), (appearance.lower, self.lower))
-            if h is not None
-        ]
-        return min(s) if s else None
+        (both must match; a part not seen does not count); None if neither was seen.
+        ``relit``: each part's :func:`~pfctl.core.perception.clothes.relit_intersection` (the
+        same clothes under other light)."""
+        return clothes_similarity(appearance, (self.upper, self.lower), self.clothes, relit)
 
     # .npz bytes ----------------------------------------------------------------------------------
 
@@ -303,6 +320,7 @@ __all__ = [
     "PROFILE_VERSION",
     "Appearance",
     "TargetProfile",
+    "clothes_similarity",
     "describe",
     "face_region",
     "head_region",

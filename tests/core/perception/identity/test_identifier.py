@@ -18,6 +18,7 @@ from pfctl.core.perception.clothes import (
     body_parts,
     color_histogram,
     histogram_intersection,
+    relit_intersection,
 )
 from pfctl.core.perception.faces import FaceEncoder
 from pfctl.core.perception.identity.identifier import Decision, TargetIdentifier
@@ -61,6 +62,36 @@ def test_color_histograms_are_normalised_and_separate_colours() -> None:
     for space in ("rgb", "lab"):
         h = color_histogram(img, top, ClothesParams(space, (8, 8, 8)))  # type: ignore[arg-type]
         assert h is not None and h.sum() == pytest.approx(1.0)
+
+
+def _dimmed(colour: tuple[int, int, int], factor: float) -> tuple[int, int, int]:
+    """The same colour under less light (each channel scaled: hue and saturation kept)."""
+    r, g, b = colour
+    return (round(r * factor), round(g * factor), round(b * factor))
+
+
+def test_the_relit_similarity_forgives_a_change_of_light_not_of_colour() -> None:
+    """Generated home 28: her trousers in the laundry, V one bin below the profile's, measured
+    S = 0.53. The relit similarity (one bin darker or brighter) finds her clothes under other
+    light, and still tells other colours apart; RGB has no brightness channel to move."""
+    params = ClothesParams("hsv", (16, 4, 4))
+    img = np.zeros((20, 30, 3), np.uint8)
+    img[:, :10], img[:, 10:20], img[:, 20:] = RED, _dimmed(RED, 0.6), GREEN
+    masks = [np.zeros((20, 30), bool) for _ in range(3)]
+    for k, mask in enumerate(masks):
+        mask[:, 10 * k : 10 * (k + 1)] = True
+    red, dim, green = (color_histogram(img, m, params) for m in masks)
+    assert red is not None and dim is not None and green is not None
+    assert histogram_intersection(dim, red) < 0.6  # below the threshold: "not her" before
+    assert relit_intersection(dim, red, params) >= 0.7
+    assert relit_intersection(red, dim, params) >= 0.7  # brighter, too
+    assert relit_intersection(red, red, params) == pytest.approx(1.0)
+    assert relit_intersection(green, red, params) == pytest.approx(0.0)
+    assert relit_intersection(green, dim, params) == pytest.approx(0.0)
+    rgb = ClothesParams("rgb", (4, 4, 4))
+    a, b = color_histogram(img, masks[0], rgb), color_histogram(img, masks[1], rgb)
+    assert a is not None and b is not None
+    assert relit_intersection(b, a, rgb) == histogram_intersection(b, a)
 
 
 def test_body_split_uses_keypoints_else_fixed_fractions_of_the_box() -> None:
@@ -468,6 +499,28 @@ def test_someone_in_her_clothes_without_a_face_is_the_candidate_to_go_and_see(le
     face = _at(_picture(RED, TARGET_FACE), 2.0, 2.0)
     assert ident.observe(4, late + 0.1, True, *face).basis == "face"
     assert ident.target_track() == 4 and ident.candidate_track() is None
+
+
+def test_her_clothes_in_other_light_are_no_evidence_against_her_nor_for_her() -> None:
+    """Her clothes under less light (one brightness bin down) are not taken as someone else's:
+    the track is undecided, not NOT_TARGET, and is the candidate to go and see; they do not
+    name her either (a change of light must not make someone else her). Other clothes are
+    still NOT_TARGET."""
+    params = IdentityParams(faces=False)
+    profile = learn_profile([describe(*_shirt((80, 150), (RED,)), params)], params)
+    ident = TargetIdentifier(profile, params)
+    dim_img, dim_det = _shirt((80, 150), (_dimmed(RED, 0.6),))
+    dim_img[150:236, 40:120] = _dimmed(NAVY, 0.6)
+    green_img, green_det = _shirt((80, 150), (GREEN,))
+    for k in range(40):  # 4 s: past the hand-off's window and confirm_s
+        t = 0.1 * k
+        dim = ident.observe(2, t, True, dim_det, dim_img)
+        other = ident.observe(3, t, True, green_det, green_img)
+    assert dim.clothes_similarity is not None and dim.clothes_relit is not None
+    assert dim.clothes_similarity < params.clothes_similarity <= dim.clothes_relit
+    assert dim.decision is Decision.UNKNOWN and dim.log_odds == pytest.approx(0.0)
+    assert other.decision is Decision.NOT_TARGET
+    assert ident.target_track() is None and ident.candidate_track() == 2
 
 
 def test_a_face_too_small_to_tell_is_no_evidence_either_way(learned) -> None:

@@ -48,3 +48,15 @@ def test_clothes_cannot_overcome_a_distractor_mark_and_her_face_can() -> None:
 def test_continuity_keeps_the_named_track_unless_a_face_says_otherwise() -> None:
     assert _lo(named=True, clothes_similarity=0.95, look_alike_about=True)[0] >= W.accept
     assert _lo(named=True, face_distance=0.9)[0] <= -W.reject
+
+
+def test_only_clothes_unlike_hers_under_every_light_count_against() -> None:
+    """Her clothes under other light (the relit similarity over the threshold) are no evidence
+    against her; the plain similarity alone says they are hers (none here: 0.53)."""
+    assert _lo(clothes_similarity=0.53, clothes_relit=0.8) == (0.0, "clothes")
+    assert _lo(clothes_similarity=0.53, clothes_relit=0.55)[0] == pytest.approx(
+        W.clothes_weight * (0.55 - 0.6) / W.clothes_scale
+    )
+    assert _lo(clothes_similarity=0.1, clothes_relit=0.2)[0] == -W.clothes_weight
+    # matching clothes count as before; the relit figure never adds to them
+    assert _lo(clothes_similarity=0.95, clothes_relit=0.99)[0] == W.clothes_weight
