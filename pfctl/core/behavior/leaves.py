@@ -416,6 +416,13 @@ class WaypointSearch(Action):
     #: stops within its own tolerance, and each new goal then stopped at once: traced, house
     #: seed 12, the base went and stopped on alternate ticks for a second).
     APPROACH_KEEP: ClassVar[float] = 0.25
+    #: ``approach_s`` counts from when the robot is this near them, m (where a face is big
+    #: enough to count); the way there may take ``APPROACH_TRAVEL_S`` more at most.
+    APPROACH_NEAR: ClassVar[float] = 3.0
+    APPROACH_TRAVEL_S: ClassVar[float] = 40.0
+    #: At the place to see them from this long with no face decided, s: they face away, and
+    #: the robot goes round to the side they face.
+    APPROACH_LOOK_S: ClassVar[float] = 2.0
 
     def initialise(self) -> None:
         self._start = self.t
@@ -431,59 +438,102 @@ class WaypointSearch(Action):
         """Looks the robot could not drive to, and when: skipped for ``RETRY_S``."""
         self._inside: dict[str, int] = {}
         self._approached: dict[int, float] = {}
-        """Candidates gone up to, and when that began."""
+        """Candidates gone up to, and when that began (-inf: given up)."""
+        self._approach_near: dict[int, float] = {}
+        """When the robot first came within ``APPROACH_NEAR`` of each candidate."""
+        self._approach_facing: dict[int, float] = {}
+        """The way a candidate who showed the robot no face is taken to face (rad)."""
         self._approach_place: tuple[int, float, tuple[float, float]] | None = None
         """The candidate's track, when its place to be seen from was chosen, and the place."""
-        self._approach_reached: tuple[float, float] | None = None
-        """The place to see a candidate from that the robot last reached."""
+        self._approach_reached: tuple[int, tuple[float, float], float] | None = None
+        """The candidate, the place to see them from that the robot last reached, and when."""
 
     def _approach_candidate(self) -> bool:
         """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
-        no face seen, not named), head on them, for at most ``approach_s`` per person: to
-        the nearest place within ``APPROACH_TO`` m of them from which they are in sight
+        no face seen, not named), head on them: to the nearest place within ``APPROACH_TO`` m
+        of them from which they are in sight
         (:func:`~pfctl.core.perception.viewpoints.nearest_viewpoint`, re-chosen every
         ``APPROACH_REPLAN_S``), so the laser sees their legs too. Seen across a room through a
         door, 5 m off, her clothes match only weakly (S ≈ 0.65) and her face is too small to
-        count; nearer, one or the other decides. A walker is not chased (they walk on; the
-        search's gaze keeps them in sight as it can). False (nothing done) when there is no
-        such person."""
+        count; nearer, one or the other decides. There ``APPROACH_LOOK_S`` with no face
+        decided, they face away: the robot goes round to a place in front of them
+        (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`, taking them to face away
+        from where it stood; traced, generated home 28: she stood with her back to the
+        laundry's door, and the robot looked at her back until it gave up). ``approach_s``
+        per person counts from when the robot is within ``APPROACH_NEAR`` of them (traced,
+        home 41: 15 s went on the way there, across the room), and the way there may take
+        ``APPROACH_TRAVEL_S`` more. A walker is not chased (they walk on; the search's gaze
+        keeps them in sight as it can). False (nothing done) when there is no such person."""
         c: TargetState | None = self.bb.candidate
         seconds = float(self.params["approach_s"])
         if c is None or seconds <= 0.0 or math.hypot(c.vx, c.vy) >= self.STANDING:
             return False
-        began = self._approached.setdefault(c.track_id, self.t)
-        if self.t - began >= seconds:
-            return False
+        track = c.track_id
+        began = self._approached.setdefault(track, self.t)
         pose = self.bb.pose
+        if math.dist((pose.x, pose.y), c.xy) <= self.APPROACH_NEAR:
+            self._approach_near.setdefault(track, self.t)
+        near = self._approach_near.get(track, math.inf)
+        if self.t - near >= seconds or self.t - began >= self.APPROACH_TRAVEL_S + seconds:
+            return False
+        reached = self._approach_reached
+        there = reached[1] if reached is not None and reached[0] == track else None
+        if (
+            there is not None
+            and reached is not None
+            and track not in self._approach_facing
+            and self.t - reached[2] >= self.APPROACH_LOOK_S
+        ):
+            self._approach_facing[track] = math.atan2(c.y - there[1], c.x - there[0])
+            self._approach_place = None  # go round now
         place = self._approach_place
-        if place is None or place[0] != c.track_id or self.t - place[1] >= self.APPROACH_REPLAN_S:
-            found = nearest_viewpoint(
-                self.world.planner,
-                (pose.x, pose.y),
-                c.xy,
-                self.APPROACH_TO,
-                self.APPROACH_MIN,
-                self.APPROACH_CLEARANCE,
-            )
+        if place is None or place[0] != track or self.t - place[1] >= self.APPROACH_REPLAN_S:
+            found = self._approach_viewpoint(c)
             if found is None:
-                self._approached[c.track_id] = -math.inf  # no place to see them from
+                self._approached[track] = -math.inf  # no place to see them from
                 return False
-            place = self._approach_place = (c.track_id, self.t, found.xy)
+            place = self._approach_place = (track, self.t, found)
         self.intents.look_at(c.xy, "candidate")  # the torso: the whole person and the face in view
         goal = place[2]
-        there = self._approach_reached
         if there is not None and math.dist(there, goal) <= self.APPROACH_KEEP:
             self.intents.stop()  # there already: a new place this near is not driven to
             return True
         facing = math.atan2(c.y - goal[1], c.x - goal[0])
         outcome = self.intents.go_to(goal, self.APPROACH_TOLERANCE, facing)
         if outcome == "failed":
-            self._approached[c.track_id] = -math.inf  # no way there: on with the search
+            self._approached[track] = -math.inf  # no way there: on with the search
             return False
         if outcome == "arrived":
-            self._approach_reached = goal
+            self._approach_reached = (track, goal, self.t)
             self.intents.stop()
         return True
+
+    def _approach_viewpoint(self, c: TargetState) -> tuple[float, float] | None:
+        """Where to see candidate ``c`` from: in front of them once they showed the robot no
+        face (:meth:`_approach_candidate`), if there is such a place; else the nearest."""
+        pose = self.bb.pose
+        facing = self._approach_facing.get(c.track_id)
+        if facing is not None:
+            front = face_viewpoint(
+                self.world.planner,
+                (pose.x, pose.y),
+                c.xy,
+                facing,
+                self.APPROACH_MIN,
+                self.APPROACH_TO,
+                clearance=self.APPROACH_CLEARANCE,
+            )
+            if front is not None:
+                return front.xy
+        found = nearest_viewpoint(
+            self.world.planner,
+            (pose.x, pose.y),
+            c.xy,
+            self.APPROACH_TO,
+            self.APPROACH_MIN,
+            self.APPROACH_CLEARANCE,
+        )
+        return None if found is None else found.xy
 
     def _fresh(self, goal: tuple[float, float]) -> bool:
         return all(math.dist(goal, v) >= self.VISITED_RADIUS for v in self._visited)

@@ -1,7 +1,8 @@
 """The way-point search leaf on constructed maps. It goes up to a standing person in her clothes
 whose face has not decided (generated home 50: seen through a door 5 m off, S ≈ 0.65, her face
-too small to count): to ``APPROACH_TO`` m, head on them, for at most ``approach_s`` per
-person; walkers are not chased, and a person it cannot reach is left. It leaves the frontiers
+too small to count): to ``APPROACH_TO`` m, head on them, round to their front when they show
+no face, for at most ``approach_s`` per person once near; walkers are not chased, and a person
+it cannot reach is left. It leaves the frontiers
 round which the camera has looked, and with none worth a visit it looks where the belief says."""
 
 from __future__ import annotations
@@ -65,11 +66,58 @@ def test_a_standing_candidate_is_gone_up_to_head_on_them_then_left_after_a_while
     short = Pose2D(goal[0] - 0.12, goal[1])
     assert rig.approach(5.0 + WaypointSearch.APPROACH_REPLAN_S, her, short) and rig.stops == 2
     assert len(rig.intents.goals) == sent
-    # her face never turned to the robot: after approach_s the search goes on past her
-    assert not rig.approach(APPROACH_S + 0.1, her, Pose2D(*goal))
+    # her face never turned to the robot: approach_s after it came near, the search goes on
+    near = 5.0  # APPROACH_NEAR was first reached at the place (the robot was 5 m off at 0 s)
+    assert rig.approach(near + APPROACH_S - 0.1, her, Pose2D(*goal))
+    assert not rig.approach(near + APPROACH_S + 0.1, her, Pose2D(*goal))
     someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
     rig.intents.nav = "running"
-    assert rig.approach(APPROACH_S + 0.2, someone_else, Pose2D(*goal))
+    assert rig.approach(near + APPROACH_S + 0.2, someone_else, Pose2D(*goal))
+
+
+def test_a_candidate_who_shows_no_face_is_seen_from_in_front() -> None:
+    """Generated home 28 (``pfctl search``): she stood with her back to the laundry's door;
+    the robot went to the nearest place to see her from, looked at her back until it gave up
+    and searched on. At the place ``APPROACH_LOOK_S`` without a face deciding, it goes round
+    to a place in front of her: beyond her as seen from where it stood, as far."""
+    rig = Rig()
+    her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
+    assert rig.approach(0.0, her, Pose2D(1.0, 3.0))
+    first = rig.intents.goals[-1]
+    assert first[0] < her.x
+    rig.intents.nav = "arrived"
+    assert rig.approach(4.0, her, Pose2D(*first))
+    rig.intents.nav = "running"
+    sent = len(rig.intents.goals)
+    assert rig.approach(4.0 + WaypointSearch.APPROACH_LOOK_S - 0.1, her, Pose2D(*first))
+    assert len(rig.intents.goals) == sent  # still looking from there
+    assert rig.approach(4.0 + WaypointSearch.APPROACH_LOOK_S, her, Pose2D(*first))
+    front = rig.intents.goals[-1]
+    assert front[0] > her.x  # the far side: she faces away from where the robot stood
+    assert abs(math.atan2(front[1] - her.y, front[0] - her.x)) <= math.radians(60) + 1e-6
+    dist = math.dist(front, her.xy)
+    assert WaypointSearch.APPROACH_MIN <= dist <= WaypointSearch.APPROACH_TO + 1e-9
+    assert rig.intents.looks[-1] == (her.xy, "candidate", None)
+
+
+def test_the_way_up_to_a_candidate_does_not_count_against_approach_s() -> None:
+    """Generated home 41: 15 s went on the way to her, across the room, and the robot gave up
+    before it was near. ``approach_s`` counts from ``APPROACH_NEAR``; the way there is bounded
+    by ``APPROACH_TRAVEL_S`` more."""
+    rig = Rig()
+    her = TargetState(4, 7.0, 3.0, 0.0, 0.0, 0.0)
+    far = Pose2D(0.5, 3.0)  # 6.5 m off
+    assert rig.approach(0.0, her, far)
+    assert rig.approach(APPROACH_S + 5.0, her, Pose2D(3.5, 3.0))  # on the way, 3.5 m off
+    assert rig.approach(APPROACH_S + 6.0, her, Pose2D(4.2, 3.0))  # near now
+    assert not rig.approach(2 * APPROACH_S + 6.1, her, Pose2D(4.8, 3.0))
+    # someone it never gets near is left after APPROACH_TRAVEL_S + approach_s
+    someone = TargetState(5, 7.0, 1.0, 0.0, 0.0, 0.0)
+    bound = WaypointSearch.APPROACH_TRAVEL_S + APPROACH_S
+    start = 100.0
+    assert rig.approach(start, someone, far)
+    assert rig.approach(start + bound - 0.1, someone, far)
+    assert not rig.approach(start + bound + 0.1, someone, far)
 
 
 def test_she_is_gone_up_to_where_she_is_in_sight_not_through_a_wall() -> None:
