@@ -1000,14 +1000,17 @@ class TargetIdentifier:
         return self._named if self._named in self._latest else None
 
     def candidate_track(self) -> int | None:
-        """An ambiguous person worth going to see the face of (issue 23, item 3): a track with
-        legs, not named, not decided NOT_TARGET, whose clothes match hers under this light or
-        another (the relit similarity; so only a face can tell: a look-alike may be about, it is
-        not confirmed yet, or the light is not the one she was learned in), not known to be someone
-        else, its face not yet seen; the most recently seen first. None when she is named, or
-        no one is ambiguous, or while the hand-off may still name her (:meth:`_hand_off`: the
-        robot does not drive up to the person it is being shown; traced, house seeds 27 and
-        48: the search drove toward her at 0.1 s, before the hand-off named her at 0.2 s)."""
+        """An ambiguous person worth going to see the face of (issue 23, item 3): a track, not
+        named, not decided NOT_TARGET, not known to be someone else, its face not yet seen,
+        whose clothes match hers under this light or another (the relit similarity; so only a
+        face can tell: a look-alike may be about, it is not confirmed yet, or the light is not
+        the one she was learned in), with legs — or, seen by the camera alone (beyond the
+        laser's legs, 6 m), in her clothes under this light (traced, generated home 41: she
+        stood 8 m off in the bedroom, S = 0.78, and the search went on to the study). The most
+        recently seen first. None when she is named, or no one is ambiguous, or while the
+        hand-off may still name her (:meth:`_hand_off`: the robot does not drive up to the
+        person it is being shown; traced, house seeds 27 and 48: the search drove toward her at
+        0.1 s, before the hand-off named her at 0.2 s)."""
         if self.target_track() is not None or self._handoff_open():
             return None
         p = self.params
@@ -1016,7 +1019,7 @@ class TargetIdentifier:
             ev = self._tracks[tid]
             if (
                 ident.decision is not Decision.NOT_TARGET
-                and ident.legs_seen
+                and (ident.legs_seen or self._dressed_as_her(ident))
                 and not ev.face_distances
                 and ev.distractor is None
                 and ident.clothes_relit is not None
@@ -1025,6 +1028,11 @@ class TargetIdentifier:
             ):
                 best = (ident.last_seen, tid)
         return None if best is None else best[1]
+
+    def _dressed_as_her(self, ident: TrackIdentity) -> bool:
+        """Whether a track's clothes match hers under this light (the plain similarity)."""
+        s = ident.clothes_similarity
+        return s is not None and s >= self.params.clothes_similarity
 
     def known_tracks(self) -> set[int]:
         """The tracks the identifier holds anything about (to :meth:`forget` when deleted)."""

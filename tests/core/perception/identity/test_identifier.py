@@ -523,6 +523,28 @@ def test_her_clothes_in_other_light_are_no_evidence_against_her_nor_for_her() ->
     assert ident.target_track() is None and ident.candidate_track() == 2
 
 
+def test_someone_the_camera_alone_sees_in_her_clothes_is_a_candidate_too() -> None:
+    """Beyond the laser's legs (6 m) the camera alone sees a person (generated home 41: she
+    stood 8 m off, S = 0.78, and the search went on past her): in her clothes under this light,
+    they are the candidate to go and see; in her clothes only under other light, not (a
+    camera-only track needs more to be driven to)."""
+    params = IdentityParams(faces=False)
+    profile = learn_profile([describe(*_shirt((80, 150), (RED,)), params)], params)
+    late = params.handoff_s + 0.1
+    ident = TargetIdentifier(profile, params)
+    for t in (0.0, late):  # past the hand-off's window
+        seen = ident.observe(2, t, False, *reversed(_shirt((80, 150), (RED,))))
+    assert seen.decision is Decision.UNKNOWN and seen.basis == "no_legs"
+    assert ident.candidate_track() == 2
+    dim_img, dim_det = _shirt((80, 150), (_dimmed(RED, 0.6),))
+    dim_img[150:236, 40:120] = _dimmed(NAVY, 0.6)
+    other = TargetIdentifier(profile, params)
+    for t in (0.0, late):
+        dim = other.observe(3, t, False, dim_det, dim_img)
+    assert dim.clothes_relit is not None and dim.clothes_relit >= params.clothes_similarity
+    assert other.candidate_track() is None
+
+
 def test_a_face_too_small_to_tell_is_no_evidence_either_way(learned) -> None:
     """A face under ``min_face_px`` (far away: dlib's embedding of a 10-px face put the target's
     own face 0.56-0.66 from her profile) neither matches nor rejects: a mismatching face that
