@@ -52,7 +52,10 @@ samples, and one odd sample (an arm across the shirt) does not; a track whose me
 within the margin of the threshold is measured on every frame again, and so is the named track's.
 A track whose clothes turn clearly unlike hers has slid onto someone else: the faces of hers it
 showed before are forgotten (they are not this person's), and if named it loses the name at
-once.
+once. "Unlike hers" is always judged on the **relit** similarity (the same clothes under other
+light, :func:`~pfctl.core.perception.clothes.relit_intersection`): the clothes count against a
+track, unlike hers, only when they are unlike hers under every light; that they are hers is
+judged on the plain one.
 
 The face search itself (dlib's HOG detector and ResNet embedding, far more than a tick's budget
 per face; benchmarks/bench_identity.py) runs inline by default, or — given a
