@@ -511,6 +511,33 @@ class TargetIdentifier:
         ev.lower = appearance.lower if appearance.lower is not None else ev.lower
         if first and ev.xy is not None and ev.distractor is None:
             self._link(ev, t)
+        elif ev.distractor is not None:
+            self._check_slid_off_distractor(ev, appearance)
+
+    def _check_slid_off_distractor(self, ev: _Evidence, appearance: Appearance) -> None:
+        """A track known not to be her without a face (``coexisted``, ``linked``) whose clothes
+        now match hers and are unlike the remembered distractor's under every light has slid
+        onto someone else: the tracker carried the distractor's coasting track onto a person in
+        her clothes (traced, the shipped house, seed 44: an extra's track, out of the camera's
+        view in the office, took her detections behind the bookshelf; it ended there, and her
+        new track was linked to the extra's memory by place, so she stayed "not her" 1 m from
+        the robot to the end). The mark, the memory and the faces the track had are the other
+        person's: all are forgotten, and she is judged afresh."""
+        p = self.params
+        clothes = ev.clothes_now(p.clothes_recent)
+        if clothes is None or clothes < p.clothes_similarity:
+            return
+        track_id = next(k for k, v in self._tracks.items() if v is ev)
+        known = self.distractors.people.get(track_id)
+        if known is None or known.upper is None or known.lower is None:
+            return
+        theirs = clothes_similarity(appearance, (known.upper, known.lower), p.clothes, relit=True)
+        if theirs is None or theirs >= p.clothes_similarity - p.clothes_margin:
+            return
+        self.distractors.forget(track_id)
+        ev.distractor = None
+        ev.face_distances.clear()
+        ev.last_match = ev.last_face = -math.inf
 
     def _link(self, ev: _Evidence, t: float) -> None:
         """A new track first measured: is it a remembered distractor (item 4)?"""

@@ -448,6 +448,32 @@ def test_a_person_rejected_by_face_stays_rejected_when_their_track_is_made_again
     assert found.decision is Decision.TARGET and ident.target_track() == 4
 
 
+def test_a_track_marked_not_her_that_slides_onto_someone_in_her_clothes_loses_the_mark(
+    learned,
+) -> None:
+    """The shipped house, seed 44: an extra's track, linked to his memory and coasting out of
+    view, took her detections behind the office's bookshelf; it ended there, her new track was
+    linked to his memory by place, and she stayed "not her" 1 m from the robot to the end. A
+    linked track whose clothes turn to hers, unlike his under every light, loses the mark and
+    his memory; she is judged afresh (her clothes, no face yet: the candidate to go and see)."""
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    him = ident.observe(2, 0.0, True, *_at(_picture(GREEN, OTHER_FACE), 2.0, 0.0))
+    assert him.decision is Decision.NOT_TARGET and him.basis == "face"
+    ident.forget(2)
+    for k in range(5):  # the tracker makes track 3 for him where he was: linked
+        seen = ident.observe(3, 1.0 + 0.1 * k, True, *_at(_picture(GREEN, None), 2.2, 0.1))
+    assert seen.decision is Decision.NOT_TARGET and seen.basis == "distractor"
+    for k in range(10):  # track 3 takes the detections of someone in her clothes, back turned
+        seen = ident.observe(3, 4.0 + 0.1 * k, True, *_at(_picture(RED, None), 2.4, 0.3))
+    assert seen.decision is not Decision.NOT_TARGET and seen.basis != "distractor"
+    assert not ident.distractors.people  # his memory went with the mark
+    assert ident.candidate_track() == 3
+    ident.forget(3)  # and a track made again where that one ended is not linked to him
+    again = ident.observe(4, 5.5, True, *_at(_picture(RED, None), 2.4, 0.3))
+    assert again.basis != "distractor"
+
+
 def test_her_appearance_is_learned_online_only_when_no_one_is_close(learned) -> None:
     """Item 5: while another person stands within ``update_clearance`` of her, the online
     appearance model does not learn; once she is alone, it does."""
