@@ -203,6 +203,9 @@ class _Evidence:
     """The newest clothing histograms measured."""
     distractor: str | None = None
     """Known not to be her without a face: ``coexisted`` or ``linked`` (distractor memory)."""
+    slid: bool = False
+    """The track slid off a distractor's mark onto someone in her clothes
+    (:meth:`TargetIdentifier._check_slid_off_distractor`): only a face names it."""
     streak: int = 0
     """Identifications in a row at TARGET (the confirmation of a switch without a face)."""
     last_match: float = -math.inf
@@ -522,7 +525,10 @@ class TargetIdentifier:
         view in the office, took her detections behind the bookshelf; it ended there, and her
         new track was linked to the extra's memory by place, so she stayed "not her" 1 m from
         the robot to the end). The mark, the memory and the faces the track had are the other
-        person's: all are forgotten, and she is judged afresh."""
+        person's: all are forgotten. Who the track follows now is not known: her, or a
+        look-alike the coasting track met (traced, the crowd, seed 14: a walker's mark slid onto
+        a look-alike, who was then named on her clothes). So her clothes are no evidence on it,
+        as while a look-alike is about: only a face names it, and it is someone to go and see."""
         p = self.params
         clothes = ev.clothes_now(p.clothes_recent)
         if clothes is None or clothes < p.clothes_similarity:
@@ -535,7 +541,7 @@ class TargetIdentifier:
         if theirs is None or theirs >= p.clothes_similarity - p.clothes_margin:
             return
         self.distractors.forget(track_id)
-        ev.distractor = None
+        ev.distractor, ev.slid = None, True
         ev.face_distances.clear()
         ev.last_match = ev.last_face = -math.inf
 
@@ -669,7 +675,7 @@ class TargetIdentifier:
             face_distance=face_d,
             clothes_similarity=clothes,
             clothes_relit=relit,
-            look_alike_about=self._look_alike_about(track_id, now),
+            look_alike_about=ev.slid or self._look_alike_about(track_id, now),
             distractor=ev.distractor is not None,
             named=track_id == self._named,
         )
