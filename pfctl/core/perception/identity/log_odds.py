@@ -72,17 +72,15 @@ def log_odds(
     if cues.face_distance is not None:
         parts["face"] = w.face_weight * _clip((face_threshold - cues.face_distance) / w.face_scale)
     if cues.clothes_similarity is not None:
-        c = w.clothes_weight * _clip(
-            (cues.clothes_similarity - clothes_threshold) / w.clothes_scale
-        )
+
+        def clothes(s: float) -> float:
+            return w.clothes_weight * _clip((s - clothes_threshold) / w.clothes_scale)
+
+        c = clothes(cues.clothes_similarity)
         if c > 0 and cues.look_alike_about:
             c = 0.0
         elif c < 0 and cues.clothes_relit is not None:
-            c = min(
-                0.0,
-                w.clothes_weight
-                * _clip((cues.clothes_relit - clothes_threshold) / w.clothes_scale),
-            )
+            c = min(0.0, clothes(cues.clothes_relit))
         parts["clothes"] = c
     if cues.distractor:
         parts["distractor"] = -w.distractor_weight
