@@ -23,15 +23,18 @@ the camera cannot tell the two apart (in her clothes, or her track out of the ca
 tracker may swap people who cross). A new track is named at once on a face match, else only after
 ``confirm_frames`` identifications in a row at TARGET over ``confirm_s`` at least (time to go and
 see the face); while a look-alike is about, clothes are no evidence, so only a face names anyone
-and otherwise she is lost. The one exception is the start of a run, the **hand-off**: the one
-person tracked within ``handoff_range`` of the camera in the first ``handoff_s``, in her clothes,
-is the person the robot was just shown and is named at once. A look-alike is about while another
-track matches her clothes, and for ``look_alike_memory_s`` after a person in her clothes was
-rejected by face, marked a distractor, or tracked at least ``coexist_distance`` from another person
-in her clothes at once (one of the two at most is her). People found not to be her are remembered
-(:mod:`~pfctl.core.perception.identity.distractors`): rejected by face, or seen at the same time as
-her face-confirmed track away from her (:meth:`TargetIdentifier.note_tracks`); a new track where
-one of them was lost stays rejected.
+and otherwise she is lost. A new track that takes her on where her named track was left (the
+camera first saw it there within a second and has not seen the old one since: the tracker lost
+her legs for a moment) is her, not a look-alike: the name follows her onto it after
+``SPLIT_FRAMES`` identifications at TARGET. The one exception is the start of a run, the
+**hand-off**: the one person tracked within ``handoff_range`` of the camera in the first
+``handoff_s``, in her clothes, is the person the robot was just shown and is named at once. A
+look-alike is about while another track matches her clothes, and for ``look_alike_memory_s``
+after a person in her clothes was rejected by face, marked a distractor, or tracked at least
+``coexist_distance`` from another person in her clothes at once (one of the two at most is her).
+People found not to be her are remembered (:mod:`~pfctl.core.perception.identity.distractors`):
+rejected by face, or seen at the same time as her face-confirmed track away from her
+(:meth:`TargetIdentifier.note_tracks`); a new track where one of them was lost stays rejected.
 Her clothes are learned online, only from frames where a face confirms her and no one else is
 within ``update_clearance``. An ambiguous person (her clothes, no face yet) is offered as
 :meth:`TargetIdentifier.candidate_track` for the robot to go and see the face.
@@ -114,6 +117,13 @@ FRESH_CLOTHES_S = 1.0
 #: How many clothes samples unlike hers, taken while no one else overlapped the person in the
 #: image, make them someone other than her for the hand-off (:meth:`TargetIdentifier._may_be_her`).
 CLEAR_SAMPLES = 3
+
+#: A track the camera first saw at most this long after it last saw another, where that one was,
+#: may be the same person picked up anew by the tracker (:meth:`TargetIdentifier._split`), s.
+SPLIT_GAP_S = 1.0
+#: ... and is named in her place after this many identifications in a row at TARGET with the
+#: other unseen (not on one frame: two people seen in turns are not one picked up anew).
+SPLIT_FRAMES = 3
 
 #: Numbers the identifiers, for their job keys.
 _IDENTIFIERS = itertools.count()
@@ -198,6 +208,11 @@ class _Evidence:
     """The face search of this track out at the worker, if any."""
     xy: tuple[float, float] | None = None
     """Where the camera last saw the track (map frame)."""
+    first_xy: tuple[float, float] | None = None
+    """Where the camera first saw the track (map frame)."""
+    first_detected: float = math.inf
+    last_detected: float = -math.inf
+    """Stamps of the first and the newest frame the camera saw the track in."""
     upper: np.ndarray | None = None
     lower: np.ndarray | None = None
     """The newest clothing histograms measured."""
@@ -492,6 +507,9 @@ class TargetIdentifier:
         ev.legs_seen += bool(has_legs)
         if detection is not None:
             ev.xy = (float(detection.position[0]), float(detection.position[1]))
+            if ev.first_xy is None:
+                ev.first_xy, ev.first_detected = ev.xy, t
+            ev.last_detected = t
             self.distractors.seen(track_id, ev.xy, t)
         return ev
 
@@ -742,11 +760,12 @@ class TargetIdentifier:
 
     def _look_alike_about(self, track_id: int, now: float) -> bool:
         """Whether someone in her clothes other than ``track_id`` is about: another track now
-        whose clothes match hers, or a person in her clothes found not to be her within
-        ``look_alike_memory_s``."""
+        whose clothes match hers (not one this track picked up from, :meth:`_split`), or a
+        person in her clothes found not to be her within ``look_alike_memory_s``."""
         p = self.params
         if now - self._look_alike_at <= p.look_alike_memory_s:
             return True
+        ev = self._tracks.get(track_id)
         for tid, other in self._tracks.items():
             clothes = other.clothes_now(p.clothes_recent)
             if (
@@ -754,9 +773,25 @@ class TargetIdentifier:
                 and other.legs_seen
                 and clothes is not None
                 and clothes >= p.clothes_similarity
+                and not (ev is not None and self._split(other, ev))
             ):
                 return True
         return False
+
+    def _split(self, old: _Evidence, new: _Evidence) -> bool:
+        """Whether ``new`` may be the person of ``old`` picked up anew (the tracker lost her
+        legs for a moment, or a camera-only track was made beside her coasting one — traced,
+        the house, seed 40: her named track stopped at the kitchen door and a new one took her
+        on): the camera first saw ``new`` at most :data:`SPLIT_GAP_S` after it last saw
+        ``old``, within ``coexist_distance`` of the place, and has not seen ``old`` since. The
+        two were never seen at once, so they are not two people in her clothes."""
+        if old.xy is None or new.first_xy is None:
+            return False
+        gap = new.first_detected - old.last_detected
+        return (
+            -STAMP_EPS <= gap <= SPLIT_GAP_S
+            and math.dist(old.xy, new.first_xy) < self.params.coexist_distance
+        )
 
     def _name(self, t: float) -> None:
         """Who is the target after this observation (item 2): the named track while the tracker
@@ -767,7 +802,12 @@ class TargetIdentifier:
         searches."""
         named = self._latest.get(self._named) if self._named is not None else None
         if named is not None and not self._doubted(named, t):
-            fresher = self._fresher_face(self._named, self._tracks[self._named].last_match)
+            picked_up = self._picked_up(named.track_id, t)
+            if picked_up is not None:
+                self._named = picked_up
+                return
+            ev = self._tracks[self._named]
+            fresher = self._fresher_face(self._named, max(ev.last_match, ev.first_detected))
             if fresher is None:
                 self._learn_online(t)
                 return
@@ -862,10 +902,31 @@ class TargetIdentifier:
         p = self.params
         return ev.streak >= p.confirm_frames and t - ev.streak_since >= p.confirm_s - STAMP_EPS
 
+    def _picked_up(self, named: int, t: float) -> int | None:
+        """The one track that took her on from the ``named`` one (:meth:`_split`), seen in this
+        frame and decided TARGET :data:`SPLIT_FRAMES` times in a row (her clothes, no look-alike
+        about, no face of someone else):
+        the name follows her (issue 23, item 1: continuity is the person's, not the track
+        number's). None when there is none, or more than one."""
+        old = self._tracks[named]
+        found = [
+            tid
+            for tid, ident in self._latest.items()
+            if tid != named
+            and ident.decision is Decision.TARGET
+            and self._tracks[tid].streak >= SPLIT_FRAMES
+            and abs(self._tracks[tid].last_detected - t) <= STAMP_EPS
+            and self._split(old, self._tracks[tid])
+        ]
+        return found[0] if len(found) == 1 else None
+
     def _fresher_face(self, named: int | None, since: float) -> int | None:
         """A track other than ``named`` that a face decides TARGET with a face match newer than
         ``since`` by ``face_recheck_s`` or more (the named track's evidence is older: the tracker
-        may have swapped it onto someone else); the newest such match first."""
+        may have swapped it onto someone else); the newest such match first. ``since`` is the
+        named track's newest face match, or its first sighting if later: a face another track
+        showed before the named one was seen at all says nothing about which is her now (the
+        track she was picked up from, :meth:`_picked_up`)."""
         best: tuple[float, int] | None = None
         for tid, ident in self._latest.items():
             ev = self._tracks[tid]
@@ -1002,9 +1063,13 @@ class TargetIdentifier:
         the camera measured within :data:`FRESH_CLOTHES_S` count (a track's old samples may be
         of someone else), whether the laser sees them or not (a track the camera alone sees
         coasts between the laser's scans): at worst her clothes are no evidence for a while,
-        which loses her rather than following someone else."""
+        which loses her rather than following someone else. The newest sample must match too:
+        a track that coasted onto a passer-by keeps her clothes in its median for a few frames
+        (traced, the house, seed 40: her old track slid onto bob at the kitchen door, and her
+        clothes were no evidence for the rest of the episode). Nor are two tracks of one person
+        two people (:meth:`_split`)."""
         p = self.params
-        dressed: list[tuple[float, float]] = []
+        dressed: list[tuple[_Evidence, float, float]] = []
         for tid, x, y, _ in tracks:
             ev = self._tracks.get(tid)
             if ev is None:
@@ -1013,12 +1078,15 @@ class TargetIdentifier:
             if (
                 clothes is not None
                 and clothes >= p.clothes_similarity
+                and ev.clothes[-1] >= p.clothes_similarity
                 and t - ev.last_clothes <= FRESH_CLOTHES_S + STAMP_EPS
             ):
-                dressed.append((x, y))
+                dressed.append((ev, x, y))
         if any(
             math.hypot(ax - bx, ay - by) >= p.coexist_distance
-            for (ax, ay), (bx, by) in itertools.combinations(dressed, 2)
+            and not self._split(a, b)
+            and not self._split(b, a)
+            for (a, ax, ay), (b, bx, by) in itertools.combinations(dressed, 2)
         ):
             self._look_alike_at = max(self._look_alike_at, t)
 

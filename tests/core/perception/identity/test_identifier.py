@@ -777,6 +777,66 @@ def test_a_passer_by_beside_her_track_out_of_view_takes_the_name_away() -> None:
         assert named[-1] == 1
 
 
+def test_her_track_picked_up_anew_takes_the_name_from_the_one_she_left(learned) -> None:
+    """The house, seed 40: her named track stopped at the kitchen door (coasting, no longer in
+    the camera's frames) and a new track took her on 0.1 m further, her back to the robot. The
+    old track is no look-alike (the two were never seen at once): after three identifications
+    in a row the name follows her onto the new track, and her old face on the track she left
+    does not take it back. A new track 2.5 m away is someone else; and so is one seen in turns
+    with hers (the camera saw both)."""
+    profile, params, encoder = learned
+    her, back = _picture(RED, TARGET_FACE), _picture(RED, None)
+    for where, in_turns, named_after in ((0.55, False, 2), (2.95, False, 1), (0.55, True, 1)):
+        ident = TargetIdentifier(profile, params, encoder)
+        for k in range(10):  # her face first, then her back, walking on
+            t = 0.1 * k
+            ident.observe(1, t, True, *_at(her if k == 0 else back, 2.0, 0.05 * k))
+        assert ident.target_track() == 1
+        names = []
+        for k in range(10, 20):
+            t = 0.1 * k
+            y = where + 0.05 * (k - 10)
+            if in_turns:
+                ident.observe(1, t - 0.05, True, *_at(back, 2.0, 0.45))
+            ident.observe(2, t, True, *_at(back, 2.0, y))
+            names.append(ident.target_track())
+        expected = [1, 1] + [2] * 8 if named_after == 2 else [1] * 10
+        assert names == expected, (where, in_turns)
+
+
+def test_a_track_that_coasted_onto_a_passer_by_is_no_look_alike() -> None:
+    """The house, seed 40: her old track, left behind at the kitchen door, picked up a passer-by
+    in other clothes 1.5 m from her. Its median still said her clothes for two frames; that did
+    not make two people in her clothes at once (its newest sample was not hers), so once she is
+    lost, a new track in her clothes is named on them as before."""
+    params = IdentityParams(faces=False, confirm_frames=5, confirm_s=0.5)
+    red, green = _shirt((80, 150), (RED,)), _shirt((80, 150), (GREEN,))
+    profile = learn_profile([describe(*red, params)], params)
+    ident = TargetIdentifier(profile, params)
+    for k in range(10):  # her, named on her clothes
+        ident.note_tracks(0.1 * k, [(1, 2.0, 0.0, True)])
+        ident.observe(1, 0.1 * k, True, *_at(red, 2.0, 0.0))
+    assert ident.target_track() == 1
+    for k in range(10, 15):  # her track 1 coasts unseen; track 2 takes her on
+        t = 0.1 * k
+        ident.note_tracks(t, [(1, 2.0, 0.0, False), (2, 2.0, 0.3, True)])
+        ident.observe(2, t, True, *_at(red, 2.0, 0.3))
+    assert ident.target_track() == 2
+    for k in range(15, 20):  # track 1 slides onto a passer-by in green, 1.5 m from her
+        t = 0.1 * k
+        ident.note_tracks(t, [(1, 2.0, -1.2, True), (2, 2.0, 0.3, True)])
+        ident.observe(1, t, True, *_at(green, 2.0, -1.2))
+        ident.observe(2, t, True, *_at(red, 2.0, 0.3))
+    assert ident.target_track() == 2
+    ident.forget(1)
+    ident.forget(2)  # she is lost ...
+    for k in range(30, 45):  # ... and found again by a new track, in her clothes
+        t = 0.1 * k
+        ident.note_tracks(t, [(5, 4.0, 0.0, True)])
+        ident.observe(5, t, True, *_at(red, 4.0, 0.0))
+    assert ident.target_track() == 5
+
+
 def test_a_look_alike_the_camera_saw_beside_her_counts_as_someone_else_when_close(learned) -> None:
     """A look-alike walks 0.8 m beside her (never 1 m apart, so not known to be someone else by
     distance), both in the camera's frames; when he comes within ``swap_distance`` the name
