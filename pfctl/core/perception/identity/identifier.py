@@ -698,7 +698,10 @@ class TargetIdentifier:
             named=track_id == self._named,
         )
         lo, basis = log_odds(cues, p.weights, p.face_distance, p.clothes_similarity)
-        if ev.legs_seen == 0:
+        if ev.legs_seen == 0 and lo > -p.weights.reject:
+            # legs first (Algorithm 2): no legs, not a person she can be — but whoever is not
+            # her, person or coat, is not her (traced, the house, seed 45: a passer-by the
+            # camera alone tracked stayed unknown and drew the gaze from her for 10 s)
             decision, conf, basis = Decision.UNKNOWN, 0.0, "no_legs"
         elif lo >= p.weights.accept:
             decision, conf = Decision.TARGET, 1.0 / (1.0 + math.exp(-lo))

@@ -218,6 +218,19 @@ def test_tracks_without_legs_are_not_candidates_and_unseen_tracks_keep_their_evi
     assert ident.observe(8, 0.1, True, None, None).decision is Decision.UNKNOWN
 
 
+def test_a_track_without_legs_in_other_clothes_is_not_her(learned) -> None:
+    """Legs first: a track without legs is never her. But one whose face or clothes are not hers
+    is not her either, legs or none (the house, seed 45: a passer-by the camera alone tracked
+    stayed unknown and drew the gaze away from her, 1.6 m off, for 10 s)."""
+    profile, params, encoder = learned
+    ident = TargetIdentifier(profile, params, encoder)
+    for k in range(5):
+        green = ident.observe(9, 0.1 * k, False, *reversed(_picture(GREEN, None)))
+        stranger = ident.observe(10, 0.1 * k, False, *reversed(_picture(RED, OTHER_FACE)))
+    assert green.decision is Decision.NOT_TARGET and green.basis == "clothes"
+    assert stranger.decision is Decision.NOT_TARGET and stranger.basis == "face"
+
+
 def test_describe_on_the_box_equals_the_whole_image() -> None:
     """describe() cuts the image and the body masks to the person's box: the histograms are the
     ones of the whole-image masks, bit for bit — with a mask, with a mask reaching outside its
