@@ -914,9 +914,8 @@ class TargetIdentifier:
     def _picked_up(self, named: int, t: float) -> int | None:
         """The one track that took her on from the ``named`` one (:meth:`_split`), seen in this
         frame and decided TARGET :data:`SPLIT_FRAMES` times in a row (her clothes, no look-alike
-        about, no face of someone else):
-        the name follows her (issue 23, item 1: continuity is the person's, not the track
-        number's). None when there is none, or more than one."""
+        about, no face of someone else): the name follows her (issue 23, item 1: continuity is
+        the person's, not the track number's). None when there is none, or more than one."""
         old = self._tracks[named]
         found = [
             tid
