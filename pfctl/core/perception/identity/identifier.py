@@ -525,12 +525,6 @@ class TargetIdentifier:
             online_relit = clothes_similarity(appearance, self._online, clothes, relit=True)
             s = s if online is None else max(s, online)
             relit = relit if online_relit is None else max(relit, online_relit)
-        if appearance.upper is None or appearance.lower is None:
-            # half her clothes are not her clothes: with one part seen (a person too near for
-            # the camera to see the legs) the clothes may be hers, never more (traced, the
-            # house, seed 30: a man in her red shirt and yellow trousers, 1 m from the robot,
-            # was named on his shirt at S = 0.76); one part unlike hers still says not her
-            s = min(s, self.params.clothes_similarity)
         first = not ev.clothes
         ev.clothes.append(s)
         ev.clothes_relit.append(max(s, relit))

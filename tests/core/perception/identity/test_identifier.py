@@ -218,24 +218,6 @@ def test_tracks_without_legs_are_not_candidates_and_unseen_tracks_keep_their_evi
     assert ident.observe(8, 0.1, True, None, None).decision is Decision.UNKNOWN
 
 
-def test_her_shirt_alone_is_not_her_clothes(learned) -> None:
-    """The house, seed 30: a man in her red shirt (and yellow trousers) 1 m from the robot; the
-    camera saw only his shirt (his legs below the image) and he was named on it, S = 0.76. One
-    part of her clothes may be hers, no more: he is not named on them, and is the candidate to
-    go and see; seen whole in her clothes, a track is named on them."""
-    profile, params, encoder = learned
-    params = replace(params, confirm_frames=3, confirm_s=0.2, handoff_s=0.0)
-    img, det = _picture(RED, None)
-    for rows, named in ((150, None), (240, 1)):
-        ident = TargetIdentifier(profile, params, encoder)
-        for k in range(10):
-            seen = ident.observe(1, 0.1 * k, True, det, img[:rows].copy())
-        assert ident.target_track() == named, rows
-        if named is None:
-            assert seen.decision is Decision.UNKNOWN
-            assert ident.candidate_track() == 1
-
-
 def test_a_track_without_legs_in_other_clothes_is_not_her(learned) -> None:
     """Legs first: a track without legs is never her. But one whose face or clothes are not hers
     is not her either, legs or none (the house, seed 45: a passer-by the camera alone tracked
