@@ -5,7 +5,10 @@ name becomes a free point of that region, an ``[x, y]`` point stays as it is) an
 between stops along paths planned on the static map for a person-sized disc, so people go through
 doors and around furniture. Speed ramps up and down smoothly (bounded acceleration, braking
 before a stop); at each intermediate stop the person pauses for about ``pause_s``. After the last
-stop a person stays there, or walks back to the first stop and starts again when ``loop``.
+stop a person stays there, or walks back to the first stop and starts again when ``loop``. A
+person whose way the robot stands in waits, and after :data:`STEP_ROUND_AFTER` seconds steps round
+it when there is room (a path no more than :data:`STEP_ROUND_DETOUR` metres longer), as people
+do: nobody stands in a hall for a minute waiting for a robot to move.
 
 The two legs are what a laser sees (the paper detects people by their legs, §II-E): cylinders of
 :data:`LEG_RADIUS` beside the body centre, swinging forward and back in opposite phase with a
@@ -37,6 +40,10 @@ ACCELERATION = 0.6
 TURN_RATE = 3.0
 #: A person's walking speed limits (``scenario.people[*].speed``), m/s.
 MIN_SPEED, MAX_SPEED = 0.3, 1.4
+#: A person the robot has kept waiting this long (s) looks for a way round it …
+STEP_ROUND_AFTER = 2.0
+#: … and takes one at most this much longer (m) than the rest of the way it was walking.
+STEP_ROUND_DETOUR = 4.0
 #: The first word of the seeds of ``scenario.randomize``'s random streams.
 RANDOMIZE = 7919
 
@@ -119,6 +126,9 @@ class Walker:
         for a, b in pairs:
             legs.append(planner.plan(a, b))
         self._legs_paths = legs
+        self._planner = planner
+        self._waited = 0.0
+        """Seconds the robot has kept this person from the next step (:meth:`_step_round`)."""
         self._leg_index = 0
         self._path = legs[0] if legs else self.stops[0][None]
         self._s = 0.0  # distance walked along the current path
@@ -154,7 +164,8 @@ class Walker:
 
         ``keep_clear`` ``(x, y, distance)``: an obstacle the person will not walk into (the
         robot). A step that would end closer than ``distance`` to it, and closer than now, is
-        not taken: the person stands and waits, as people do when a robot is in their way.
+        not taken: the person stands and waits, as people do when a robot is in their way, and
+        after STEP_ROUND_AFTER seconds of it walks round the robot (:meth:`_step_round`).
         """
         if dt <= 0:
             return
@@ -179,7 +190,12 @@ class Walker:
             if after < clear and after < math.hypot(self.x - ox, self.y - oy):
                 self.speed = 0.0
                 self._settle_legs(dt)
+                self._waited += dt
+                if self._waited >= STEP_ROUND_AFTER:
+                    self._waited = 0.0
+                    self._step_round(ox, oy, clear)
                 return
+        self._waited = 0.0
         self.speed, self._s = speed, s
         self.x, self.y = float(pos[0]), float(pos[1])
         want = math.atan2(direction[1], direction[0])
@@ -189,6 +205,25 @@ class Walker:
         self.phase = (self.phase + 2 * math.pi * self._cadence() * dt) % (2 * math.pi)
         if self._s >= float(self._cum[-1]) - 1e-9:
             self._arrive()
+
+    def _step_round(self, ox: float, oy: float, clear: float) -> None:
+        """Walk the rest of this leg round the obstacle at ``(ox, oy)``: re-plan from here to the
+        leg's end with it a disc that keeps ``clear`` metres from its centre, and take the path
+        if it is at most STEP_ROUND_DETOUR longer. Where there is no room (the robot in a
+        door, or at the leg's end) the person waits on. The route's own legs are unchanged, so a
+        looping person walks them again next time."""
+        rest = float(self._cum[-1]) - self._s
+        disc = clear - self._planner.robot_radius + 0.05
+        try:
+            path = self._planner.with_obstacles([(ox, oy)], disc).plan(
+                (self.x, self.y), self._path[-1]
+            )
+        except NoPathError:
+            return
+        cum = self._cumulative(path)
+        if float(cum[-1]) > rest + STEP_ROUND_DETOUR:
+            return
+        self._path, self._cum, self._s = path, cum, 0.0
 
     def _cadence(self) -> float:
         """Gait cycles per second: two steps of ``0.3 + 0.25·v`` metres per cycle (≈0.8 Hz at

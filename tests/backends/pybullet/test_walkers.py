@@ -7,7 +7,14 @@ import pytest
 import shapely
 
 from pfctl.app.sim import sim_config
-from pfctl.backends.pybullet.walkers import LEG_RADIUS, PERSON_RADIUS, Walker, make_walkers
+from pfctl.backends.pybullet.config import Clothes
+from pfctl.backends.pybullet.walkers import (
+    LEG_RADIUS,
+    PERSON_RADIUS,
+    STEP_ROUND_AFTER,
+    Walker,
+    make_walkers,
+)
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
 from pfctl.mission import Mission, ScenarioConfig
@@ -118,3 +125,42 @@ def test_look_alike_loop_and_random_people(mission: Mission, planner: GridPlanne
     assert not bob.done  # a looping person keeps walking
     again = _make_walkers(m, planner, seed=5)
     assert [w.clothes for w in again] == [w.clothes for w in walkers]
+
+
+#: How near the simulator lets a person come to the robot's centre (its radius, a body, courtesy).
+CLEAR = 0.215 + 0.2 + 0.15
+
+
+def _walk_past_a_robot(planner: GridPlanner, start, end, robot_xy, seconds: float) -> list:
+    """A person walks ``start`` → ``end`` while a robot stands still at ``robot_xy``."""
+    walker = Walker(
+        "p",
+        [np.array(start), np.array(end)],
+        planner.with_radius(PERSON_RADIUS),
+        speed=0.8,
+        clothes=Clothes((0, 0, 0), (0, 0, 0)),
+    )
+    track = []
+    for _ in range(int(seconds / DT)):
+        walker.step(DT, keep_clear=(*robot_xy, CLEAR))
+        track.append((walker.x, walker.y))
+        if walker.done:
+            break
+    return np.array(track)
+
+
+def test_a_person_steps_round_a_robot_standing_in_the_hall_but_waits_in_a_door(
+    planner: GridPlanner,
+) -> None:
+    """Along the hall (y = 5 m) a robot stands on the person's way: the person waits a little
+    (STEP_ROUND_AFTER), then walks round it, never within the courtesy distance, and arrives.
+    A robot standing in the kitchen's door to the hall leaves no room: the person waits."""
+    hall = _walk_past_a_robot(planner, (1.0, 5.0), (8.0, 5.0), (4.0, 5.0), 30.0)
+    assert np.linalg.norm(hall[-1] - (8.0, 5.0)) < 1e-6  # arrived
+    gap = np.linalg.norm(hall - (4.0, 5.0), axis=1)
+    assert gap.min() >= CLEAR - 0.05
+    still = np.linalg.norm(np.diff(hall, axis=0), axis=1) < 1e-9
+    assert DT * still.sum() >= STEP_ROUND_AFTER - DT  # it did wait first
+    door = _walk_past_a_robot(planner, (1.5, 3.2), (2.5, 5.0), (2.3, 4.0), 30.0)
+    assert np.linalg.norm(door - (2.3, 4.0), axis=1).min() >= CLEAR - 0.05
+    assert np.linalg.norm(door[-1] - (2.5, 5.0)) > 1.0  # never got through
