@@ -13,16 +13,11 @@ pure pursuit cuts the corners of a path, and people walk across it). It re-plans
 points (laser returns that are not part of the static map) lie on the path ahead, or when the
 robot makes no progress for :data:`STUCK_TIME` seconds, marking those points as obstacles;
 after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Like move_base's costmap,
-which clears a cell only where a beam of the laser passed through it (ray tracing), a marked
-point is forgotten when a beam of the scan passed through its place and ended beyond it; a mark
-the laser cannot see (behind a table, out of the field of view) is kept for
-:data:`UNSEEN_BLOCKER_MEMORY` seconds — a person who stepped behind the furniture has not gone,
-and a robot halfway round them would otherwise turn back into them. Without a scan (points
-only) a mark is forgotten :data:`BLOCKER_MEMORY` seconds after the laser last showed something
-there. While the path goes round marked points it is planned again every
-:data:`RECONSIDER_PERIOD` seconds and the new path taken when it is :data:`RECONSIDER_GAIN`
-metres shorter — a person who stood in a door for a moment does not send the robot round the
-house. Pure numpy: no pybullet.
+which clears what the laser no longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
+seconds after the laser last showed something there; while the path goes round marked points it
+is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken when it is
+:data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment does not send
+the robot round the house. Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -34,7 +29,7 @@ from scipy import optimize
 from scipy.spatial import cKDTree
 
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
-from pfctl.core.robot import STOP, LaserScan, NavStatus, Pose2D, Twist2D
+from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
 
 #: Pure-pursuit carrot distance along the path, metres.
 LOOKAHEAD = 0.5
@@ -59,11 +54,6 @@ REPLAN_RESET = 1.5
 #: A marked obstacle point is forgotten this long (s) after the laser last showed a point within
 #: BLOCKER_RADIUS of it (people move on; move_base's costmap clears them too).
 BLOCKER_MEMORY = 4.0
-#: With a scan: a mark no beam has looked through is forgotten this long (s) after the laser last
-#: showed a point within BLOCKER_RADIUS of it (a ghost must not close a door for good) …
-UNSEEN_BLOCKER_MEMORY = 15.0
-#: … and a beam looked through a mark when it ended at least this far (m) beyond it.
-CLEARED_BEYOND = 0.15
 #: While the path goes round marked points, it is planned again this often (s) …
 RECONSIDER_PERIOD = 2.0
 #: … and the new path is taken when it is at least this much shorter than the rest (m).
@@ -187,25 +177,15 @@ class Navigator:
         stamps = np.full(len(points), self._clock)
         self._blocker_seen = np.concatenate([self._blocker_seen, stamps])[-400:]
 
-    def _refresh_blockers(self, dynamic: np.ndarray, scan: LaserScan | None) -> None:
-        """Marks with a sensed point within BLOCKER_RADIUS are seen now. With a ``scan``, the
-        others are forgotten where a beam looked through them (:func:`looked_through`) and kept
-        UNSEEN_BLOCKER_MEMORY seconds where none did; without one, marks not seen for
+    def _refresh_blockers(self, dynamic: np.ndarray) -> None:
+        """Marks with a sensed point within BLOCKER_RADIUS are seen now; marks not seen for
         BLOCKER_MEMORY seconds are forgotten."""
         if not len(self._blockers):
             return
-        seen = np.zeros(len(self._blockers), dtype=bool)
         if len(dynamic):
             d, _ = cKDTree(dynamic).query(self._blockers, distance_upper_bound=BLOCKER_RADIUS)
-            seen = np.isfinite(d)
-            self._blocker_seen[seen] = self._clock
-        if scan is None:
-            keep = self._clock - self._blocker_seen <= BLOCKER_MEMORY
-        else:
-            keep = seen | (
-                ~looked_through(scan, self._blockers)
-                & (self._clock - self._blocker_seen <= UNSEEN_BLOCKER_MEMORY)
-            )
+            self._blocker_seen[np.isfinite(d)] = self._clock
+        keep = self._clock - self._blocker_seen <= BLOCKER_MEMORY
         self._blockers, self._blocker_seen = self._blockers[keep], self._blocker_seen[keep]
 
     def _planner_now(self) -> GridPlanner:
@@ -341,23 +321,14 @@ class Navigator:
         if self.path is not None:
             self._rest_at_replan = self._remaining(np.array([pose.x, pose.y]))[0]
 
-    def update(
-        self,
-        pose: Pose2D,
-        dt: float,
-        obstacle_points: np.ndarray | None = None,
-        scan: LaserScan | None = None,
-    ) -> Twist2D:
+    def update(self, pose: Pose2D, dt: float, obstacle_points: np.ndarray | None = None) -> Twist2D:
         """The robot-frame command for this control period (STOP unless ACTIVE).
 
         A goal taken by :meth:`accept` is planned here first (from ``pose``).
-        ``obstacle_points`` are map-frame points the robot currently senses; those away from
-        the static map that lie on the path ahead trigger a re-plan around them. Given the
-        ``scan`` they came from (map-frame pose; its points when ``obstacle_points`` is None),
-        marks are cleared by ray tracing (:meth:`_refresh_blockers`).
+        ``obstacle_points`` are map-frame points the robot currently senses (e.g.
+        ``LaserScan.points()``); those away from the static map that lie on the path ahead
+        trigger a re-plan around them.
         """
-        if obstacle_points is None and scan is not None:
-            obstacle_points = scan.points()
         if self._unplanned and self._status is NavStatus.ACTIVE:
             self._plan(pose)
         if self._status is not NavStatus.ACTIVE or self.goal is None or self.path is None:
@@ -381,7 +352,7 @@ class Navigator:
         dynamic = self._dynamic(obstacle_points)
         self._clock += dt
         self._since_reconsider += dt
-        self._refresh_blockers(dynamic, scan)
+        self._refresh_blockers(dynamic)
         rest, i, proj = self._remaining(xy)
         if self._round_marks and self._since_reconsider >= RECONSIDER_PERIOD:
             self._reconsider(pose, rest)
@@ -431,22 +402,6 @@ class Navigator:
         return Twist2D(c * vx_map + s * vy_map, -s * vx_map + c * vy_map, wz)
 
 
-def looked_through(scan: LaserScan, points: np.ndarray) -> np.ndarray:
-    """Whether the beam of ``scan`` nearest in bearing to each map-frame point passed through it
-    and ended at least CLEARED_BEYOND metres beyond it (``inf``, no return in range, counts as
-    beyond): the ray tracing by which move_base's costmap clears cells. A point outside the
-    field of view, out of range, or behind a nearer return was not looked through."""
-    pts = np.asarray(points, dtype=float).reshape(-1, 2)
-    rel = pts - (scan.pose.x, scan.pose.y)
-    dist = np.hypot(rel[:, 0], rel[:, 1])
-    bearing = (np.arctan2(rel[:, 1], rel[:, 0]) - scan.pose.theta + math.pi) % (2 * math.pi)
-    beam = np.rint((bearing - math.pi - scan.angle_min) / scan.angle_increment).astype(int)
-    ranges = np.asarray(scan.ranges, dtype=float)
-    inside = (beam >= 0) & (beam < len(ranges)) & (dist < scan.range_max)
-    reach = np.where(inside, ranges[np.clip(beam, 0, len(ranges) - 1)], 0.0)
-    return inside & (reach >= dist + CLEARED_BEYOND)
-
-
 def keep_clear(
     v: np.ndarray,
     xy: np.ndarray,
@@ -482,4 +437,4 @@ def keep_clear(
     return np.where(np.abs(out) < 1e-12, 0.0, out)
 
 
-__all__ = ["Navigator", "keep_clear", "looked_through"]
+__all__ = ["Navigator", "keep_clear"]

@@ -159,7 +159,6 @@ class SimRobot:
         self.dropped_scans = 0
         """Scans dropped unobserved because more than a second's worth was waiting."""
         self._scan_points: np.ndarray | None = None
-        self._nav_scan: LaserScan | None = None
         self._frame: RgbdFrame | None = None
         self._next_scan = 0.0
         self._next_frame = 0.0
@@ -240,9 +239,7 @@ class SimRobot:
             raise RuntimeError("the simulator is closed")
         dt = self.substep
         if self._navigating:
-            self._cmd = self.clamp(
-                self.navigator.update(self.pose, dt, self._scan_points, self._nav_scan)
-            )
+            self._cmd = self.clamp(self.navigator.update(self.pose, dt, self._scan_points))
             if self.navigator.status is not NavStatus.ACTIVE:
                 self._navigating = False
         self._move(dt)
@@ -384,8 +381,7 @@ class SimRobot:
                 self._sync_bodies()
                 synced = True
             scan = self.laser.scan(self.pose, self._legs(), self.time)
-            self._nav_scan = scan  # MOVE_BASE's view, with the true pose
-            self._scan_points = scan.points()
+            self._scan_points = scan.points()  # MOVE_BASE's view, with the true pose
             believed = self.laser_spec.laser_pose(self.localized_pose)
             if len(self._scans) == self._scans.maxlen:
                 self.dropped_scans += 1

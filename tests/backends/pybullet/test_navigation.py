@@ -8,19 +8,10 @@ import numpy as np
 import pytest
 import shapely
 
-from pfctl.backends.pybullet.laser import FastLaser, LaserSpec
-from pfctl.backends.pybullet.navigation import (
-    BLOCKER_MEMORY,
-    PERSON_MARGIN,
-    UNSEEN_BLOCKER_MEMORY,
-    WALL_MARGIN,
-    Navigator,
-    keep_clear,
-    looked_through,
-)
+from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
-from pfctl.core.robot import LaserScan, NavStatus, Pose2D, Twist2D
+from pfctl.core.robot import NavStatus, Pose2D, Twist2D
 from pfctl.mission import Mission
 
 pytestmark = pytest.mark.sim
@@ -201,49 +192,3 @@ def test_navigator_does_not_drive_into_a_person_standing_on_its_path(
         pose = Pose2D(pose.x + vx * DT, pose.y + vy * DT, pose.theta + cmd.wz * DT)
         gap = np.linalg.norm(legs - (pose.x, pose.y), axis=1).min()
         assert gap >= planner.robot_radius + PERSON_MARGIN - 0.07  # one step of overshoot
-
-
-#: A 6 x 6 m room with a 1 x 1 m table (counter-clockwise outlines) for the ray-tracing tests.
-_ROOM = np.array([[-3, -3, 3, -3], [3, -3, 3, 3], [3, 3, -3, 3], [-3, 3, -3, -3]], dtype=float)
-_TABLE = np.array([[1, -0.5, 2, -0.5], [2, -0.5, 2, 0.5], [2, 0.5, 1, 0.5], [1, 0.5, 1, -0.5]])
-
-
-def _room_scan(pose: Pose2D, legs: np.ndarray | None = None) -> LaserScan:
-    laser = FastLaser(np.vstack([_ROOM, _TABLE]), LaserSpec(noise_std=0.0))
-    return laser.scan(pose, np.empty((0, 3)) if legs is None else legs, 0.0)
-
-
-def test_looked_through_only_where_a_beam_passed_and_ended_beyond() -> None:
-    """The laser at the origin looks east; a table stands 1–2 m ahead, a person at (0, 1.5)."""
-    person = np.array([[0.0, 1.5, 0.1]])
-    scan = _room_scan(Pose2D(-0.167, 0.0, 0.0), person)  # the laser itself at the origin
-    free = [0.5, 0.0]  # before the table, in plain view
-    hidden = [2.5, 0.0]  # behind the table
-    behind_robot = [-2.0, 0.0]  # outside the 270° field of view
-    at_person = [0.0, 1.45]  # the person's own near surface
-    past_person = [0.0, 2.2]  # in the person's shadow
-    beside = [0.6, 1.5]  # the same distance, in plain view
-    pts = np.array([free, hidden, behind_robot, at_person, past_person, beside])
-    assert looked_through(scan, pts).tolist() == [True, False, False, False, False, True]
-    # no return in range (an open door to nowhere) counts as looked through
-    empty = FastLaser(np.empty((0, 4)), LaserSpec(noise_std=0.0)).scan(Pose2D(0, 0, 0), person, 0)
-    assert looked_through(empty, np.array([[3.0, -1.0]])).tolist() == [True]
-
-
-def test_a_mark_hidden_by_furniture_is_kept_and_one_looked_through_is_forgotten(
-    planner: GridPlanner,
-) -> None:
-    """Marks are forgotten by ray tracing, as move_base's costmap clears them: one the laser
-    looks through goes at once, one the table hides stays longer than BLOCKER_MEMORY (the rule
-    without a scan), until UNSEEN_BLOCKER_MEMORY."""
-    nav = Navigator(planner, 0.22, 0.8)
-    nav._mark(np.array([[0.5, 0.0], [2.5, 0.0]]))  # in plain view; behind the table
-    scan = _room_scan(Pose2D(-0.167, 0.0, 0.0))
-    nav._refresh_blockers(np.empty((0, 2)), scan)
-    assert nav._blockers.tolist() == [[2.5, 0.0]]
-    nav._clock += BLOCKER_MEMORY + 1.0
-    nav._refresh_blockers(np.empty((0, 2)), scan)
-    assert nav._blockers.tolist() == [[2.5, 0.0]]
-    nav._clock += UNSEEN_BLOCKER_MEMORY  # a ghost does not close the way for good
-    nav._refresh_blockers(np.empty((0, 2)), scan)
-    assert len(nav._blockers) == 0
