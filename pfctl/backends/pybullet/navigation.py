@@ -9,7 +9,10 @@ speed limit, slowing down near the goal, while the base turns toward its directi
 to the goal's heading at the end). Like move_base's local planner it never drives into what the
 laser senses: :func:`keep_clear` removes the part of the command that would bring the base
 closer than a margin to a sensed point (sliding along a wall, stopping short of a person; the
-pure pursuit cuts the corners of a path, and people walk across it). It re-plans when obstacle
+pure pursuit cuts the corners of a path, and people walk across it), nor to a person's point
+sensed in the last :data:`RECENT_PEOPLE_S` seconds: the laser sees 270°, and a person who walked
+round the robot into the blind sector behind it is still there (move_base's costmap, too, keeps
+what the laser no longer sees). It re-plans when obstacle
 points (laser returns that are not part of the static map) lie on the path ahead, or when the
 robot makes no progress for :data:`STUCK_TIME` seconds, marking those points as obstacles;
 after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Like move_base's costmap,
@@ -61,8 +64,10 @@ RECONSIDER_GAIN = 1.0
 #: The local safety layer (:func:`keep_clear`): no velocity toward a sensed point of the static
 #: map (a wall, furniture) within the robot's radius plus this, metres …
 WALL_MARGIN = 0.06
-#: … nor toward any other sensed point (a person's leg) within the radius plus this, metres.
+#: … nor toward any other sensed point (a person's leg) within the radius plus this, metres, …
 PERSON_MARGIN = 0.2
+#: … sensed in the last this many seconds (a person behind the robot, out of the laser's view).
+RECENT_PEOPLE_S = 1.5
 
 
 def _wrap(a: float) -> float:
@@ -109,6 +114,11 @@ class Navigator:
         self._rest_at_replan = math.inf
         self._unplanned = False
         """A goal was accepted and is not planned yet (the next update plans it)."""
+        self._uptime = 0.0
+        """Seconds of active :meth:`update` over all goals (never reset)."""
+        self._recent: list[tuple[float, np.ndarray, object]] = []
+        """``(uptime, dynamic points, the obstacle points they came from)`` of the last
+        RECENT_PEOPLE_S seconds, one entry per scan, for :func:`keep_clear`."""
 
     @property
     def status(self) -> NavStatus:
@@ -253,6 +263,15 @@ class Navigator:
             return np.empty((0, 2))
         return geo.cell_to_world(rr + rs.start, cc + cs.start)
 
+    def _recent_people(self, dynamic: np.ndarray, source: object, dt: float) -> np.ndarray:
+        """The dynamic points sensed in the last RECENT_PEOPLE_S seconds, ``dynamic`` (from the
+        obstacle points ``source``) among them: a new entry per new scan."""
+        self._uptime += dt
+        self._recent = [r for r in self._recent if self._uptime - r[0] <= RECENT_PEOPLE_S]
+        if not self._recent or self._recent[-1][2] is not source:
+            self._recent.append((self._uptime, dynamic, source))
+        return np.vstack([r[1] for r in self._recent])
+
     def _remaining(self, xy: np.ndarray) -> tuple[float, int, np.ndarray]:
         """Distance left along the path, the index of the nearest segment, the projection."""
         assert self.path is not None
@@ -351,6 +370,7 @@ class Navigator:
             return Twist2D(0.0, 0.0, wz)
         dynamic = self._dynamic(obstacle_points)
         self._clock += dt
+        people = self._recent_people(dynamic, obstacle_points, dt)
         self._since_reconsider += dt
         self._refresh_blockers(dynamic)
         rest, i, proj = self._remaining(xy)
@@ -393,7 +413,7 @@ class Navigator:
         v_map = keep_clear(
             speed * direction / n,
             xy,
-            dynamic,
+            people,
             np.vstack([self._static(obstacle_points), self._map_near(xy)]),
             self.planner.robot_radius,
         )

@@ -8,7 +8,13 @@ import numpy as np
 import pytest
 import shapely
 
-from pfctl.backends.pybullet.navigation import PERSON_MARGIN, WALL_MARGIN, Navigator, keep_clear
+from pfctl.backends.pybullet.navigation import (
+    PERSON_MARGIN,
+    RECENT_PEOPLE_S,
+    WALL_MARGIN,
+    Navigator,
+    keep_clear,
+)
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
 from pfctl.core.robot import NavStatus, Pose2D, Twist2D
@@ -192,3 +198,27 @@ def test_navigator_does_not_drive_into_a_person_standing_on_its_path(
         pose = Pose2D(pose.x + vx * DT, pose.y + vy * DT, pose.theta + cmd.wz * DT)
         gap = np.linalg.norm(legs - (pose.x, pose.y), axis=1).min()
         assert gap >= planner.robot_radius + PERSON_MARGIN - 0.07  # one step of overshoot
+
+
+def test_a_person_seen_a_moment_ago_behind_the_robot_is_still_kept_clear_of(
+    planner: GridPlanner,
+) -> None:
+    """The laser saw a person beside the way back a moment ago; now they are in its blind
+    sector (the scans show nothing). The base sets off that way and must not close on them
+    for RECENT_PEOPLE_S seconds (the person walked round the robot and stood, as in the crowd)."""
+    nav = Navigator(planner, 0.22, 0.8)
+    pose = Pose2D(4.0, 5.0, 0.0)  # facing east, in the hall
+    nav.start(Pose2D(1.0, 5.0, math.pi), pose)  # the way back west
+    angles = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    leg = np.array([3.6, 5.35]) + 0.06 * np.column_stack((np.cos(angles), np.sin(angles)))
+    reach = planner.robot_radius + PERSON_MARGIN
+    seen = {"t": 0.0}
+
+    def scan(pose: Pose2D) -> np.ndarray:
+        seen["t"] += DT
+        return leg if seen["t"] <= DT else np.empty((0, 2))  # one scan, then out of view
+
+    poses, _ = _drive(nav, pose, RECENT_PEOPLE_S - DT, scan)
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert xy[-1, 0] < 3.9  # it did set off
+    assert np.linalg.norm(xy[:, None] - leg[None], axis=2).min() >= reach - 0.03
