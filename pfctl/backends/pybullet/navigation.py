@@ -12,11 +12,11 @@ closer than a margin to a sensed point (sliding along a wall, stopping short of 
 pure pursuit cuts the corners of a path, and people walk across it), nor to a person's point
 sensed in the last :data:`RECENT_PEOPLE_S` seconds: the laser sees 270°, and a person who walked
 round the robot into the blind sector behind it is still there (move_base's costmap, too, keeps
-what the laser no longer sees). It re-plans when obstacle
-points (laser returns that are not part of the static map) lie on the path ahead, or when the
-robot makes no progress for :data:`STUCK_TIME` seconds, marking those points as obstacles;
-after :data:`MAX_REPLANS` re-plans without success the goal is ABORTED. Like move_base's costmap,
-which clears what the laser no longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
+what the laser no longer sees). It re-plans when obstacle points (laser returns that are not
+part of the static map) lie on the path ahead, or when the robot makes no progress for
+:data:`STUCK_TIME` seconds, marking those points as obstacles; after :data:`MAX_REPLANS` re-plans
+without success the goal is ABORTED. Like move_base's costmap, which clears what the laser no
+longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
 seconds after the laser last showed something there; while the path goes round marked points it
 is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken when it is
 :data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment does not send

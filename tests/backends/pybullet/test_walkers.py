@@ -8,6 +8,7 @@ import shapely
 
 from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.config import Clothes
+from pfctl.backends.pybullet.simulation import PERSON_CONTACT_RADIUS, PERSON_COURTESY
 from pfctl.backends.pybullet.walkers import (
     LEG_RADIUS,
     PERSON_RADIUS,
@@ -128,10 +129,10 @@ def test_look_alike_loop_and_random_people(mission: Mission, planner: GridPlanne
 
 
 #: How near the simulator lets a person come to the robot's centre (its radius, a body, courtesy).
-CLEAR = 0.215 + 0.2 + 0.15
+CLEAR = 0.215 + PERSON_CONTACT_RADIUS + PERSON_COURTESY
 
 
-def _walk_past_a_robot(planner: GridPlanner, start, end, robot_xy, seconds: float) -> list:
+def _walk_past_a_robot(planner: GridPlanner, start, end, robot_xy, seconds: float) -> np.ndarray:
     """A person walks ``start`` → ``end`` while a robot stands still at ``robot_xy``."""
     walker = Walker(
         "p",
