@@ -173,7 +173,15 @@ class Follower:
         self.planner = GridPlanner(static_map, robot_radius)
         self.dt = 1.0 / params.tick_hz
         whereabouts = Whereabouts(regions, static_map.geometry, static_map.states() == FREE)
-        self.world = WorldModel(self.grid, self.planner, regions, params.search, whereabouts)
+        self.world = WorldModel(
+            self.grid,
+            self.planner,
+            regions,
+            params.search,
+            whereabouts,
+            sight_blocked=static_map.states() != FREE,
+            camera_range=perception.camera_range,
+        )
         self.navigation = Navigation()
         self.intents = Intents(params.control, self.world, self.navigation)
         self.gaze = GazeController(params.control)

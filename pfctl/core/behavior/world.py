@@ -17,6 +17,9 @@ from numpy.typing import ArrayLike, NDArray
 from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, waypoint_search
+from pfctl.core.perception.belief import visible_mask
+from pfctl.core.perception.tracking import FieldOfView
+from pfctl.core.robot import Pose2D
 from pfctl.core.search.whereabouts import Whereabouts
 
 #: Cells at least this likely occupied block the line of sight (the grid's occupied threshold).
@@ -33,6 +36,9 @@ class WorldModel:
         regions: RegionMap,
         search: SearchParams,
         whereabouts: Whereabouts | None = None,
+        *,
+        sight_blocked: ArrayLike | None = None,
+        camera_range: tuple[float, float] | None = None,
     ) -> None:
         self.grid = grid
         """The robot's occupancy grid (Eq. 1), updated with every scan."""
@@ -42,6 +48,10 @@ class WorldModel:
         self.search = search
         self.whereabouts = whereabouts
         """Where the lost target can be (None: not kept); the follower feeds it."""
+        self.sight_blocked = None if sight_blocked is None else np.asarray(sight_blocked, bool)
+        """The static map's cells that block the camera's line of sight (None: not known)."""
+        self.camera_range = camera_range
+        """The depth interval in which the camera sees people, m (None: not known)."""
         self.sensor_stamp: float | None = None
         """Stamp of the newest laser scan, s (None before the first)."""
         self.people_xy: NDArray[np.float64] = np.empty((0, 2))
@@ -56,6 +66,20 @@ class WorldModel:
         """The cells of the robot's grid that are occupied (they block the line of sight)."""
         blocked: NDArray[np.bool_] = self.grid.logodds >= _OCCUPIED_LOGODDS
         return blocked
+
+    def unseen_in_sight(self, t: float, pose: Pose2D) -> float | None:
+        """The floor area (m²) where she can be (the belief over where she can be,
+        :attr:`whereabouts`, at ``t``) that the camera has not seen since the loss and could
+        see from ``pose``, turning all round: within :attr:`camera_range`, in line of sight on
+        the static map. What looking round here can still find; None while there is no belief
+        (none kept, or at rest) or the camera is not known."""
+        wb = self.whereabouts
+        if wb is None or not wb.active or self.sight_blocked is None or self.camera_range is None:
+            return None
+        fov = FieldOfView(Pose2D(pose.x, pose.y, 0.0), np.pi, *self.camera_range)
+        cells = visible_mask(wb.geometry, fov, self.sight_blocked) & ~np.isfinite(wb.seen_at)
+        cells &= wb.cell_probabilities(t) > 0.0
+        return float(cells.sum()) * wb.geometry.resolution**2
 
     def free_goal(self, xy: ArrayLike) -> tuple[float, float] | None:
         """``xy`` moved into free space for the robot (:meth:`GridPlanner.free_goal`)."""

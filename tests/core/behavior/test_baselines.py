@@ -29,16 +29,24 @@ from pfctl.core.behavior.leaves import (
     leaf_factory,
 )
 from pfctl.core.behavior.tree import build_tree
+from pfctl.core.behavior.world import WorldModel
 from pfctl.core.control import ControlParams
 from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.paths import distance_fields, traversability
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.regions import RegionMap, WaypointDecision, waypoint_search
+from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, waypoint_search
+from pfctl.core.perception.belief import visible_mask
+from pfctl.core.perception.tracking import FieldOfView
 from pfctl.core.perception.viewpoints import nearest_viewpoint
 from pfctl.core.prediction.models import make_model
 from pfctl.core.robot import Pose2D
+from pfctl.core.search.whereabouts import Whereabouts
 from pfctl.mission import load_mission
+from tests.core.search.test_gaze import _walls as _three_room_walls
+from tests.core.search.test_whereabouts import GEOMETRY as THREE_ROOMS_GRID
+from tests.core.search.test_whereabouts import HOME as THREE_ROOMS
+from tests.core.search.test_whereabouts import PARAMS as WHEREABOUTS
 
 MISSIONS = Path(__file__).resolve().parents[3] / "missions"
 BASELINES = MISSIONS / "baselines"
@@ -159,7 +167,10 @@ def test_the_nearest_frontier_baselines_set_the_choice_for_the_follower() -> Non
 
 class _Idle:
     """A robot and a perception that are never asked for anything (the follower's prediction
-    needs neither); close() and command() are called when the follower closes."""
+    needs neither); close() and command() are called when the follower closes, and the
+    camera's range is read when it is built."""
+
+    camera_range = (0.4, 8.0)
 
     def command(self, *args: Any) -> None:
         pass
@@ -289,6 +300,8 @@ class TreeRig:
         self.bb = py_trees.blackboard.Client(name="rig", namespace=self.ns)
         for key in KEYS:
             self.bb.register_key(key, access=Access.WRITE)
+        # no belief over where she can be is kept here: a look-around sweeps its full length
+        self.bb.world = SimpleNamespace(unseen_in_sight=lambda t, pose: None)
 
     def tick(
         self,
@@ -352,6 +365,60 @@ def test_the_last_seen_tree_drives_there_then_looks_around_and_keeps_its_arrival
     assert rig.intents.kinds().count("go_to") == 1
     # seen again: follow
     assert rig.tick(11.0, _target(11.0), other) == (Status.RUNNING, "follow_target")
+
+
+def _world_of_three_rooms(lost_at: tuple[float, float]) -> WorldModel:
+    """The search tests' corridor with three rooms off it (``tests/core/search``), its walls
+    blocking the camera, and a belief over where she can be since she was lost at ``lost_at``
+    20 s before t = 0 (she can be in any room by now)."""
+    walls = _three_room_walls()
+    wb = Whereabouts(RegionMap(THREE_ROOMS), THREE_ROOMS_GRID, ~walls, WHEREABOUTS)
+    wb.lost(-20.0, lost_at)
+    grid = OccupancyGrid.from_probabilities(walls.astype(float), THREE_ROOMS_GRID.resolution)
+    return WorldModel(
+        grid,
+        GridPlanner(grid, 0.2),
+        RegionMap(THREE_ROOMS),
+        SearchParams(),
+        wb,
+        sight_blocked=walls,
+        camera_range=(0.4, 8.0),
+    )
+
+
+def test_a_look_around_ends_once_every_place_in_sight_has_been_seen() -> None:
+    """At the mid room's door: once the camera has seen all it can from there (the corridor
+    and the mid room through the door), the sweep ends — after ``min_seconds``, not 8 s —
+    and the tree moves on; the rooms behind the walls are not in sight and do not hold it."""
+    rig = TreeRig("last_seen.yaml")
+    world = _world_of_three_rooms((4.5, 1.0))
+    rig.bb.world = world
+    here = Pose2D(4.5, 1.0, 0.0)
+    seen = Sighting(0.0, (4.5, 1.0), np.array([[0.0, 4.5, 1.0]]))
+    rig.intents.nav = "arrived"
+    assert rig.tick(0.1, None, seen, here) == (Status.RUNNING, "look_around")
+    unseen = world.unseen_in_sight(0.1, here)
+    assert unseen is not None and unseen > 10.0  # nothing seen yet: corridor and mid room
+    all_round = FieldOfView(Pose2D(4.5, 1.0, 0.0), math.pi, 0.4, 8.0)
+    world.whereabouts.observe(0.5, visible_mask(THREE_ROOMS_GRID, all_round, world.sight_blocked))
+    assert world.unseen_in_sight(0.5, here) == 0.0
+    assert rig.tick(0.6, None, seen, here) == (Status.RUNNING, "look_around")  # < min_seconds
+    assert rig.tick(1.2, None, seen, here) == (Status.SUCCESS, "stop")  # looked: on with it
+
+
+def test_a_look_around_with_places_in_sight_unseen_sweeps_on() -> None:
+    """The same, but the camera has seen only the corridor: the mid room, in sight through its
+    door, is not seen yet, so the sweep goes on."""
+    rig = TreeRig("last_seen.yaml")
+    world = _world_of_three_rooms((4.5, 1.0))
+    rig.bb.world = world
+    here = Pose2D(4.5, 1.0, 0.0)
+    seen = Sighting(0.0, (4.5, 1.0), np.array([[0.0, 4.5, 1.0]]))
+    rig.intents.nav = "arrived"
+    corridor = world.whereabouts.labels == world.regions.names.index("corridor")
+    world.whereabouts.observe(0.05, corridor)
+    for k in range(1, 60):
+        assert rig.tick(k * 0.1, None, seen, here) == (Status.RUNNING, "look_around")
 
 
 # --------------------------------------------------------------------------------------------

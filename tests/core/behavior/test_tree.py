@@ -180,7 +180,10 @@ def test_paper_tree_from_the_house_mission_resolves_every_leaf() -> None:
     calls = {name: (kind, params) for kind, name, params in h.calls}
     assert calls["target_visible"] == ("condition", {"max_age": 0.5})
     assert calls["follow_target"] == ("action", {"distance": None})  # the mission's value
-    assert calls["look_around"] == ("action", {"seconds": 8.0, "pan": 1.4, "turn": True})
+    assert calls["look_around"] == (
+        "action",
+        {"seconds": 8.0, "pan": 1.4, "turn": True, "until_looked": True, "min_seconds": 1.0},
+    )
     assert [name for _, name, _ in h.calls] == [
         "target_visible",
         "follow_target",
