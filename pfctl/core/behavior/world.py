@@ -3,7 +3,8 @@
 A :class:`WorldModel` sits on the blackboard (key ``world``). It holds the robot's occupancy grid
 (Eq. 1: it starts unknown and fills in as the laser sees the house), the static map's planner
 (walls and furniture inflated by the robot's radius), the region map of Algorithm 1, the
-belief over where a lost target can be (:class:`~pfctl.core.search.whereabouts.Whereabouts`), and,
+belief over where a lost target can be (:class:`~pfctl.core.search.whereabouts.Whereabouts`) with
+what the camera can see of it (the static map's walls and furniture, the camera's range), and,
 per tick, the other people the tracker holds and the stamp of the newest laser scan. The follower's
 perceive stage keeps it up to date; leaves read it to run their control laws (the base's
 line-of-sight check, Algorithm 1) and never write it.
