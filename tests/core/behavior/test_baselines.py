@@ -386,39 +386,45 @@ def _world_of_three_rooms(lost_at: tuple[float, float]) -> WorldModel:
     )
 
 
+#: Where the look-around tests stand (the mid room's door) and the sighting that sent them there.
+MID_DOOR = Pose2D(4.5, 1.0, 0.0)
+MID_DOOR_SEEN = Sighting(0.0, (4.5, 1.0), np.array([[0.0, 4.5, 1.0]]))
+
+
+def _looking_round_at_the_mid_door() -> tuple[TreeRig, WorldModel]:
+    """The last-seen tree, arrived at ``MID_DOOR`` (where she was last seen), in the world of
+    :func:`_world_of_three_rooms`."""
+    rig = TreeRig("last_seen.yaml")
+    world = _world_of_three_rooms((MID_DOOR.x, MID_DOOR.y))
+    rig.bb.world = world
+    rig.intents.nav = "arrived"
+    return rig, world
+
+
 def test_a_look_around_ends_once_every_place_in_sight_has_been_seen() -> None:
     """At the mid room's door: once the camera has seen all it can from there (the corridor
     and the mid room through the door), the sweep ends — after ``min_seconds``, not 8 s —
     and the tree moves on; the rooms behind the walls are not in sight and do not hold it."""
-    rig = TreeRig("last_seen.yaml")
-    world = _world_of_three_rooms((4.5, 1.0))
-    rig.bb.world = world
-    here = Pose2D(4.5, 1.0, 0.0)
-    seen = Sighting(0.0, (4.5, 1.0), np.array([[0.0, 4.5, 1.0]]))
-    rig.intents.nav = "arrived"
-    assert rig.tick(0.1, None, seen, here) == (Status.RUNNING, "look_around")
-    unseen = world.unseen_in_sight(0.1, here)
+    rig, world = _looking_round_at_the_mid_door()
+    assert rig.tick(0.1, None, MID_DOOR_SEEN, MID_DOOR) == (Status.RUNNING, "look_around")
+    unseen = world.unseen_in_sight(0.1, MID_DOOR)
     assert unseen is not None and unseen > 10.0  # nothing seen yet: corridor and mid room
-    all_round = FieldOfView(Pose2D(4.5, 1.0, 0.0), math.pi, 0.4, 8.0)
+    all_round = FieldOfView(MID_DOOR, math.pi, 0.4, 8.0)
     world.whereabouts.observe(0.5, visible_mask(THREE_ROOMS_GRID, all_round, world.sight_blocked))
-    assert world.unseen_in_sight(0.5, here) == 0.0
-    assert rig.tick(0.6, None, seen, here) == (Status.RUNNING, "look_around")  # < min_seconds
-    assert rig.tick(1.2, None, seen, here) == (Status.SUCCESS, "stop")  # looked: on with it
+    assert world.unseen_in_sight(0.5, MID_DOOR) == 0.0
+    # within min_seconds it sweeps on; after, it has looked: on with the tree
+    assert rig.tick(0.6, None, MID_DOOR_SEEN, MID_DOOR) == (Status.RUNNING, "look_around")
+    assert rig.tick(1.2, None, MID_DOOR_SEEN, MID_DOOR) == (Status.SUCCESS, "stop")
 
 
 def test_a_look_around_with_places_in_sight_unseen_sweeps_on() -> None:
     """The same, but the camera has seen only the corridor: the mid room, in sight through its
     door, is not seen yet, so the sweep goes on."""
-    rig = TreeRig("last_seen.yaml")
-    world = _world_of_three_rooms((4.5, 1.0))
-    rig.bb.world = world
-    here = Pose2D(4.5, 1.0, 0.0)
-    seen = Sighting(0.0, (4.5, 1.0), np.array([[0.0, 4.5, 1.0]]))
-    rig.intents.nav = "arrived"
+    rig, world = _looking_round_at_the_mid_door()
     corridor = world.whereabouts.labels == world.regions.names.index("corridor")
     world.whereabouts.observe(0.05, corridor)
     for k in range(1, 60):
-        assert rig.tick(k * 0.1, None, seen, here) == (Status.RUNNING, "look_around")
+        assert rig.tick(k * 0.1, None, MID_DOOR_SEEN, MID_DOOR) == (Status.RUNNING, "look_around")
 
 
 # --------------------------------------------------------------------------------------------
