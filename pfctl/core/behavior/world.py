@@ -18,9 +18,8 @@ from numpy.typing import ArrayLike, NDArray
 from pfctl.core.mapping.grid import OCCUPIED_THRESH, OccupancyGrid, logit
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision, waypoint_search
-from pfctl.core.perception.belief import visible_mask
-from pfctl.core.perception.tracking import FieldOfView
 from pfctl.core.robot import Pose2D
+from pfctl.core.search.gaze import in_sight_all_round
 from pfctl.core.search.whereabouts import Whereabouts
 
 #: Cells at least this likely occupied block the line of sight (the grid's occupied threshold).
@@ -77,8 +76,8 @@ class WorldModel:
         wb = self.whereabouts
         if wb is None or not wb.active or self.sight_blocked is None or self.camera_range is None:
             return None
-        fov = FieldOfView(Pose2D(pose.x, pose.y, 0.0), np.pi, *self.camera_range)
-        cells = visible_mask(wb.geometry, fov, self.sight_blocked) & ~np.isfinite(wb.seen_at)
+        cells = in_sight_all_round(wb, self.sight_blocked, pose, self.camera_range)
+        cells &= ~np.isfinite(wb.seen_at)
         cells &= wb.cell_probabilities(t) > 0.0
         return float(cells.sum()) * wb.geometry.resolution**2
 

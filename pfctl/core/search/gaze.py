@@ -30,7 +30,7 @@ from pfctl.core.search.whereabouts import Whereabouts
 
 XY = tuple[float, float]
 
-__all__ = ["UnseenGaze", "UnseenView", "unseen_view"]
+__all__ = ["UnseenGaze", "UnseenView", "in_sight_all_round", "unseen_view"]
 
 #: Bearing bins of the window sum (5°).
 _BINS = 72
@@ -64,6 +64,18 @@ def _window_mass(
     padded = np.concatenate([hist[-half:], hist, hist[:half]]) if half else hist
     sums = np.convolve(padded, np.ones(2 * half + 1), mode="valid")
     return sums[:_BINS]
+
+
+def in_sight_all_round(
+    whereabouts: Whereabouts,
+    blocked: NDArray[np.bool_],
+    pose: Pose2D,
+    camera_range: tuple[float, float],
+) -> NDArray[np.bool_]:
+    """The cells of ``whereabouts``' grid a camera at ``pose`` could see turning all round:
+    within ``camera_range`` (m), in line of sight past ``blocked`` (walls, furniture)."""
+    fov = FieldOfView(Pose2D(pose.x, pose.y, 0.0), math.pi, *camera_range)
+    return visible_mask(whereabouts.geometry, fov, blocked)
 
 
 def unseen_view(
@@ -154,8 +166,7 @@ class UnseenGaze:
         if t - self._decided_at < self.every_s:
             return None if self._view is None else self._view.xy
         self._decided_at = t
-        fov = FieldOfView(Pose2D(pose.x, pose.y, 0.0), math.pi, *camera_range)
-        visible = visible_mask(wb.geometry, fov, self.blocked)
+        visible = in_sight_all_round(wb, self.blocked, pose, camera_range)
         unseen = ~np.isfinite(wb.seen_at)
         views = unseen_view(
             wb.cell_probabilities(t), unseen, visible, self._centres, pose, hfov, self.pan_limits
