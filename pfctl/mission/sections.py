@@ -232,6 +232,7 @@ class TrackingConfig(CoreSection, core=TrackerParams):
     tentative_timeout_s: FromCore
     max_coast_s: FromCore
     max_coast_unseen_s: FromCore
+    new_id_beyond: FromCore
 
 
 class BeliefConfig(CoreSection, core=BeliefParams):

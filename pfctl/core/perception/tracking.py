@@ -45,7 +45,11 @@ leg clusters of any confidence with the existing tracks but start tracks only fr
 * A COASTING track is deleted once unseen for ``max_coast_s`` while its predicted position is
   inside the field of view of the sensor being processed (it should have been seen), or once
   unseen for ``max_coast_unseen_s`` anywhere. A detection inside its gate re-associates it: same
-  id, CONFIRMED again.
+  id, CONFIRMED again — unless the detection is ``new_id_beyond`` or more from where the motion
+  model put the track. Then the track goes on under a new id: only a track that coasted a while
+  has a gate that wide (it grows with the cube of the time unseen, to metres after 2 s), and
+  someone found that far off its course may be another person. Who it is is then for
+  identification to say, not for the tracker.
 
 **Fields of view.** :class:`FieldOfView` is a floor wedge (origin pose, half-angle, range
 interval); :meth:`FieldOfView.from_scan` also keeps the scan's ranges so that a position behind
@@ -234,6 +238,14 @@ class TrackerParams:
         unit="s",
         gt=0,
     )
+    new_id_beyond: float = param(
+        1.0,
+        "A detection that joins a track this far or farther from where the track's motion put"
+        " it (only a track that coasted a while has so wide a gate) goes on under a new id:"
+        " where it is no longer says who it is, so identification decides afresh.",
+        unit="m",
+        gt=0,
+    )
     initial_speed_std: float = 1.0
     """Std of each velocity component of a new track, m/s (people walk at up to ~1.5 m/s)."""
     spawn_sensors: tuple[str, ...] = SENSORS
@@ -248,6 +260,7 @@ class TrackerParams:
             "tentative_timeout_s",
             "max_coast_s",
             "max_coast_unseen_s",
+            "new_id_beyond",
             "initial_speed_std",
         ):
             value = getattr(self, name)
@@ -487,10 +500,17 @@ class MultiPersonTracker:
         pairs = self._associate(z, R)
         out: list[int | None] = [None] * len(detections)
         associated = set()
+        # How far each detection is from where the motion model put its track, before the update.
+        jump = np.zeros(len(pairs))
         if pairs:
-            batch_update([self._entries[i].kf for i, _ in pairs], z[[j for _, j in pairs]], R)
-        for i, j in pairs:
+            rows, cols = [i for i, _ in pairs], [j for _, j in pairs]
+            predicted = np.array([self._entries[i].kf.x[:2] for i in rows])
+            jump = np.hypot(*(z[cols] - predicted).T)
+            batch_update([self._entries[i].kf for i in rows], z[cols], R)
+        for (i, j), moved in zip(pairs, jump.tolist(), strict=True):
             entry = self._entries[i]
+            if moved >= p.new_id_beyond and entry.status is not TrackStatus.TENTATIVE:
+                entry.id = next(self._ids)  # far off its course: maybe someone else
             entry.hits += 1
             entry.last_seen = now
             entry.last_seen_by[sensor] = now

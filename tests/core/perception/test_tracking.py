@@ -205,6 +205,25 @@ def test_track_out_of_every_view_is_deleted_after_max_coast_unseen_s() -> None:
     assert tracker.track(the_id) is None
 
 
+@pytest.mark.parametrize(("away", "same_id"), [(0.5, True), (1.5, False)])
+def test_a_track_found_again_far_off_its_course_goes_on_under_a_new_id(
+    away: float, same_id: bool
+) -> None:
+    """House seed 39 (issue 22): her track coasted out of view behind a wall, and 2.3 s later the
+    camera glimpsed a man 2.9 m from where the track's motion put her, inside its grown gate; the
+    track took him, and her name went with it. A detection that joins a track ``new_id_beyond``
+    (1 m) or more off its course keeps the track's state but not its id, so identification
+    decides who it is afresh."""
+    tracker = MultiPersonTracker(TrackerParams(new_id_beyond=1.0))
+    the_id = confirmed_person(tracker, (2.0, 0.0))
+    elsewhere = FieldOfView(Pose2D(0.0, 0.0, math.pi), math.radians(30.0), 0.0, 10.0)
+    (got,) = tracker.update(CAMERA, dets([(2.0, away)]), elsewhere, tracker.time + 2.5)
+    assert (got == the_id) is same_id
+    assert [tr.id for tr in tracker.tracks()] == [got]  # joined: no other track started
+    track = tracker.track(got)
+    assert track is not None and track.status is TrackStatus.CONFIRMED and track.hits > 10
+
+
 # ----------------------------------------------------------------- life cycle, clutter, ids
 
 
