@@ -31,6 +31,7 @@ stops the base.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -78,6 +79,7 @@ from pfctl.core.episode import (
     WaypointRecord,
 )
 from pfctl.core.mapping.grid import FREE, InverseSensorModel, OccupancyGrid
+from pfctl.core.mapping.paths import line_of_sight
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import (
     RegionMap,
@@ -140,6 +142,9 @@ class FollowerParams:
     """The gaze looks at the belief peak only above this probability."""
     room_horizon_s: float = 5.0
     """The room prediction made at a loss is of where she is this long after it, s."""
+    stranger_range: float = 4.0
+    """A person the camera has not seen is worth a glance within this far, m (their clothes
+    decide at that distance)."""
 
 
 class Follower:
@@ -204,6 +209,7 @@ class Follower:
         self._writer.intents = self.intents
         self._writer.waypoint = None
         self._writer.candidate = None
+        self._writer.stranger = None
         self._writer.true_target = None
         self._true_target = true_target
         self._now = 0.0
@@ -292,6 +298,24 @@ class Follower:
         if track is None:
             return None
         return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
+
+    def _stranger_state(self, now: float, pose: Pose2D) -> TargetState | None:
+        """The nearest person whom no camera frame has shown yet (the laser's legs alone, seen
+        within ``visible_age``), within ``stranger_range`` of the robot and in its line of sight
+        on the static map: a glance tells whether she is the one (issue 22)."""
+        here = (pose.x, pose.y)
+        sight = self.world.sight_blocked
+        best: tuple[float, TargetState] | None = None
+        for track in self.perception.strangers(now, self.params.visible_age):
+            d = math.dist(here, track.position)
+            if d > self.params.stranger_range or (best is not None and d >= best[0]):
+                continue
+            if sight is not None and not line_of_sight(
+                sight, self.planner.static.geometry, here, track.position
+            ):
+                continue
+            best = (d, TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen))
+        return None if best is None else best[1]
 
     def _visible(self, now: float, target: TargetState | None) -> bool:
         """The target was detected within ``visible_age`` seconds."""
@@ -410,6 +434,7 @@ class Follower:
         w.last_seen = self._last_seen
         w.prediction = self._prediction
         w.candidate = self._candidate_state() if target is None else None
+        w.stranger = self._stranger_state(obs.stamp, obs.pose) if target is None else None
         if self._true_target is not None:
             w.true_target = self._true_target()
         self.intents.begin(obs.stamp, obs.pose)

@@ -33,6 +33,8 @@ KEYS: dict[str, str] = {
     "intents": "Intents: what the leaves want the base and the head to do this tick",
     "candidate": "TargetState | None: while she is not named, an ambiguous person (her clothes, "
     "no face seen yet, not known to be someone else) worth going to see the face of (see_face)",
+    "stranger": "TargetState | None: while she is not named, the nearest person in sight whom "
+    "no camera frame has shown yet (the laser's legs alone), worth a glance (waypoint_search)",
     "waypoint": "WaypointDecision | None: Algorithm 1's latest way-point (waypoint_search)",
     "true_target": "PRIVILEGED (simulator's ground truth) tuple[float, float] | None: where the "
     "target really is; filled only for a tree naming oracle_search, the one leaf that reads it",

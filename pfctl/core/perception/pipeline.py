@@ -240,6 +240,17 @@ class Perception:
         track_id = self.identifier.candidate_track()
         return None if track_id is None else self.tracker.track(track_id)
 
+    def strangers(self, now: float, max_age: float) -> list[Track]:
+        """The people no camera frame has shown yet: tracks measured within ``max_age`` s of
+        ``now`` that Algorithm 2 holds nothing about (the laser's legs alone)."""
+        if self.identifier is None:
+            return []
+        return [
+            t
+            for t in self.tracks()
+            if now - t.last_seen <= max_age and self.identifier.identity(t.id) is None
+        ]
+
     def not_target(self, exclude: int | None = None) -> list[tuple[float, float]]:
         """Where the people are whose tracks Algorithm 2 has identified as not the target (track
         ``exclude`` left out)."""

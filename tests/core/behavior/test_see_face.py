@@ -34,7 +34,9 @@ class Intents:
         self.goals: list[tuple[float, float]] = []
         self.stops = 0
         self.looks: list[tuple[tuple[float, float], str, float | None]] = []
+        self.turns: list[float] = []
         self.nav = "running"
+        self.control = SimpleNamespace(max_angular_speed=0.8)
 
     def claim(self, action: str) -> None:
         pass
@@ -48,6 +50,9 @@ class Intents:
     def go_to(self, xy: tuple[float, float], tolerance: float, face: float | None = None) -> str:
         self.goals.append(xy)
         return self.nav
+
+    def turn(self, wz: float) -> None:
+        self.turns.append(wz)
 
     def look_at(
         self, xy: tuple[float, float], source: str = "target", height: float | None = None
@@ -76,6 +81,7 @@ class Rig:
             None,
             None,
         )
+        self.bb.stranger = None
 
     def tick(self, t: float, candidate: TargetState | None, pose: Pose2D) -> Status:
         self.bb.t, self.bb.pose, self.bb.candidate = t, pose, candidate

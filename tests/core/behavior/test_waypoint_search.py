@@ -11,6 +11,7 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 from py_trees.common import Status
 
 from pfctl.core.behavior.blackboard import TargetState
@@ -164,6 +165,33 @@ def test_the_leaf_runs_the_approach_before_its_search() -> None:
     rig.leaf.tick_once()
     assert rig.leaf.status is Status.RUNNING
     assert rig.intents.looks[-1][1] == "candidate"
+
+
+def test_a_person_the_camera_has_not_seen_is_glanced_at_base_turning_then_left() -> None:
+    """House seed 43: her legs stood 1.5 m behind the robot, past the office's bookshelf; the
+    head turned toward them from behind at 1 rad/s and the search drove on before the camera got
+    there. A standing person whom no frame has shown (blackboard ``stranger``) is looked at, the
+    base stopped and turned toward them, for ``glance_s`` at most; a walker is not."""
+    rig = Rig()
+    glance_s = rig.leaf.params["glance_s"]
+    legs = TargetState(9, 0.0, 3.3, 0.05, 0.0, 0.0)  # standing 1 m behind the robot, left
+    rig.bb.stranger = legs
+    rig.bb.t, rig.bb.pose = 0.0, Pose2D(1.0, 3.0, 0.0)
+    assert rig.leaf._glance_at_stranger()
+    assert rig.intents.looks[-1] == (legs.xy, "stranger", None)
+    assert rig.intents.turns == [pytest.approx(0.8)]  # at full speed, the short way: left
+    rig.bb.t, rig.bb.pose = 2.0, Pose2D(1.0, 3.0, 2.8)  # turned to face them
+    assert rig.leaf._glance_at_stranger()
+    assert rig.intents.stops == 1 and len(rig.intents.turns) == 1
+    rig.bb.t = glance_s + 0.1  # no frame has shown them in glance_s: on with the search
+    assert not rig.leaf._glance_at_stranger()
+    rig.bb.stranger = TargetState(10, 0.0, 3.0, 0.5, 0.0, 0.0)  # a walker
+    assert not rig.leaf._glance_at_stranger()
+    rig.bb.stranger = TargetState(11, 1.0, 4.0, 0.0, 0.0, 0.0)  # another standing person
+    assert rig.leaf._glance_at_stranger()
+    rig.leaf.params.update(glance_s=0.0)  # missions/trees/paper_literal.yaml
+    rig.bb.stranger = TargetState(12, 1.0, 4.0, 0.0, 0.0, 0.0)
+    assert not rig.leaf._glance_at_stranger()
 
 
 def _frontier(wb: Whereabouts, x0: float, x1: float, y: float) -> FrontierCluster:
