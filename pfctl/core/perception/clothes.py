@@ -15,7 +15,10 @@ sides). Rows: with keypoints, the upper body runs from ``neck`` to ``mid_hip`` a
 from ``mid_hip`` down to ``ankles`` (or the box's bottom); without, fixed fractions of the box
 height from human proportions (Drillis & Contini 1966: shoulders at ~18 %, hips at ~48-53 % of
 the height from the top): upper 20-48 %, lower 55-95 %. The gap around the hips keeps the belt
-line (either colour) out of both.
+line (either colour) out of both. Keypoints without the torso (a person hidden behind another
+but for their feet, or their head) leave both parts empty: the box is then only what shows, and
+its fractions would take shoes for a shirt (traced, house seed 45: behind a passer-by, her feet
+measured as her upper body made her "not her", and the robot lost her).
 
 **Relit similarity** (:func:`relit_intersection`). The same clothes under other light — another
 room, the side away from the lamp, a camera's exposure — keep their hue but move along the
@@ -248,6 +251,8 @@ def _part_rows(
         bottom = kp["ankles"][1] if "ankles" in kp else y1
         upper_rows = (top + gap, hip - gap)
         lower_rows = (hip + gap, bottom)
+    elif kp:  # a pose without the torso: where the shirt ends is not known, so no part is
+        upper_rows = lower_rows = (y0, y0)
     else:
         upper_rows = (y0 + UPPER_ROWS[0] * height, y0 + UPPER_ROWS[1] * height)
         lower_rows = (y0 + LOWER_ROWS[0] * height, y0 + LOWER_ROWS[1] * height)

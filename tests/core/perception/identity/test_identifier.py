@@ -108,6 +108,26 @@ def test_body_split_uses_keypoints_else_fixed_fractions_of_the_box() -> None:
     assert 150 < rows_l.min() <= 155 and rows_l.max() == 189
 
 
+def test_a_pose_without_the_torso_measures_no_clothes() -> None:
+    """House seed 45: a passer-by stood between the robot and her, and the camera showed her
+    feet below him (a box 22 px high at the image's bottom, keypoints: the ankles). The box's
+    fixed fractions took her shoes for her shirt; clothes unlike hers un-named her. A pose that
+    found no torso says where neither part is, so no clothes are measured."""
+    shape, feet = (240, 320), (179, 218, 197, 240)
+    mask = np.zeros(shape, dtype=bool)
+    mask[218:240, 179:197] = True
+    for kp in ({"ankles": (188.0, 239.0)}, {"head": (188.0, 225.0)}):
+        upper, lower = body_parts(shape, feet, mask, kp)
+        assert not upper.any() and not lower.any()
+    rgb = np.zeros((*shape, 3), dtype=np.uint8)
+    rgb[mask] = GREY
+    det = PersonDetection(feet, (1.0, 0.0, 1.0), mask=mask, keypoints={"ankles": (188.0, 239.0)})
+    seen = describe(rgb, det, IdentityParams())
+    assert seen.upper is None and seen.lower is None
+    upper, _ = body_parts(shape, feet, mask)  # no pose at all (HOG): the box's fractions
+    assert upper.any()
+
+
 def _profile(faces: int = 2) -> TargetProfile:
     rng = np.random.default_rng(1)
     upper, lower = rng.random(256), rng.random(256)
