@@ -90,6 +90,7 @@ from pfctl.core.mapping.regions import (
 )
 from pfctl.core.params import param
 from pfctl.core.perception.pipeline import Perception, in_stamp_order
+from pfctl.core.perception.tracking import Track
 from pfctl.core.prediction.clipping import clip_prediction
 from pfctl.core.prediction.models import (
     DEFAULT_MODEL,
@@ -145,6 +146,13 @@ class FollowerParams:
     stranger_range: float = 4.0
     """A person the camera has not seen is worth a glance within this far, m (their clothes
     decide at that distance)."""
+
+
+def _track_state(track: Track | None) -> TargetState | None:
+    """A track as the blackboard's track state (None for None)."""
+    if track is None:
+        return None
+    return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
 
 
 class Follower:
@@ -287,17 +295,11 @@ class Follower:
         return target
 
     def _target_state(self) -> TargetState | None:
-        track = self.perception.target()
-        if track is None:
-            return None
-        return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
+        return _track_state(self.perception.target())
 
     def _candidate_state(self) -> TargetState | None:
         """The ambiguous person worth a look at the face (issue 23, item 3), as a track state."""
-        track = self.perception.candidate()
-        if track is None:
-            return None
-        return TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen)
+        return _track_state(self.perception.candidate())
 
     def _stranger_state(self, now: float, pose: Pose2D) -> TargetState | None:
         """The nearest person whom no camera frame has shown yet (the laser's legs alone, seen
@@ -305,7 +307,7 @@ class Follower:
         on the static map: a glance tells whether she is the one (issue 22)."""
         here = (pose.x, pose.y)
         sight = self.world.sight_blocked
-        best: tuple[float, TargetState] | None = None
+        best: tuple[float, Track] | None = None
         for track in self.perception.strangers(now, self.params.visible_age):
             d = math.dist(here, track.position)
             if d > self.params.stranger_range or (best is not None and d >= best[0]):
@@ -314,8 +316,8 @@ class Follower:
                 sight, self.planner.static.geometry, here, track.position
             ):
                 continue
-            best = (d, TargetState(track.id, track.x, track.y, track.vx, track.vy, track.last_seen))
-        return None if best is None else best[1]
+            best = (d, track)
+        return _track_state(None if best is None else best[1])
 
     def _visible(self, now: float, target: TargetState | None) -> bool:
         """The target was detected within ``visible_age`` seconds."""
