@@ -194,6 +194,57 @@ def test_a_person_the_camera_has_not_seen_is_glanced_at_base_turning_then_left()
     assert not rig.leaf._glance_at_stranger()
 
 
+def _decision(goals: list[tuple[float, float]], utilities: list[float]) -> WaypointDecision:
+    """Algorithm 1's frontier decision over one-point clusters at ``goals`` (Eq. 3 utilities)."""
+    clusters = tuple(
+        FrontierCluster(np.zeros((1, 2), dtype=np.intp), np.array([g]), g, 10) for g in goals
+    )
+    best = int(np.argmax(utilities))
+    return WaypointDecision(
+        waypoint=goals[best],
+        heading_region=None,
+        target_region=None,
+        target_point=None,
+        reason="frontier",
+        clusters=clusters,
+        goals=tuple(goals),
+        utilities=tuple(utilities),
+        best=best,
+    )
+
+
+def test_after_a_glance_the_search_goes_on_to_the_way_point_it_had() -> None:
+    """``pfctl search`` over ROS, house seed 2: 1 m short of the living room's door, where she
+    stood, a line of sight grazing the door's jamb made her legs a stranger for one tick. The
+    glance dropped the way-point, the search chose afresh without the hysteresis that keeps a
+    way-point (``KEEP_RADIUS``), went to the hall and did not find her in 60 s. After a glance
+    the way-point goes on, and the next decision keeps it while its frontier is there."""
+    rig = Rig()
+    door, hall = (5.2, 2.4), (3.2, 4.2)
+    later = _decision([(5.3, 2.5), hall], [0.5, 1.0])  # the hall's frontier scores higher now
+    decisions = iter([_decision([door, hall], [1.0, 0.5])])
+    rig.bb.world = SimpleNamespace(
+        whereabouts=None,
+        planner=_room(),
+        search=SearchParams(strategy="paper"),
+        next_waypoint=lambda history, here: next(decisions, later),
+    )
+    robot = Pose2D(3.8, 1.8)
+    rig.bb.t, rig.bb.pose = 0.0, robot
+    rig.leaf.tick_once()
+    assert rig.intents.goals[-1] == door
+    rig.bb.t, rig.bb.stranger = 1.0, TargetState(9, 7.1, 3.4, 0.0, 0.0, 0.0)  # her legs
+    rig.leaf.tick_once()
+    assert rig.intents.looks[-1][1] == "stranger" and len(rig.intents.turns) == 1
+    rig.bb.t, rig.bb.stranger = 1.1, None  # out of sight again a tick later
+    rig.leaf.tick_once()
+    assert rig.intents.goals[-1] == door  # not the hall
+    rig.bb.t = WaypointSearch.REPLAN_S + 0.1  # the next decision keeps the door's frontier
+    rig.leaf.tick_once()
+    assert rig.intents.goals[-1] == (5.3, 2.5)
+    assert hall not in rig.intents.goals
+
+
 def _frontier(wb: Whereabouts, x0: float, x1: float, y: float) -> FrontierCluster:
     """A frontier along ``y`` from ``x0`` to ``x1`` on the whereabouts' grid."""
     xs = np.arange(x0, x1, wb.geometry.resolution)
