@@ -432,6 +432,7 @@ class Follower:
         w = self._writer
         w.t = obs.stamp
         w.pose = obs.pose
+        w.head = obs.head
         w.target = target
         w.last_seen = self._last_seen
         w.prediction = self._prediction

@@ -33,6 +33,7 @@ KEYS: dict[str, str] = {
     "intents": "Intents: what the leaves want the base and the head to do this tick",
     "candidate": "TargetState | None: while she is not named, an ambiguous person (her clothes, "
     "no face seen yet, not known to be someone else) worth going to see the face of (see_face)",
+    "head": "HeadState: the head's pan and tilt now (joint angles, rad)",
     "stranger": "TargetState | None: while she is not named, the nearest person in sight whom "
     "no camera frame has shown yet (the laser's legs alone), worth a glance (waypoint_search)",
     "waypoint": "WaypointDecision | None: Algorithm 1's latest way-point (waypoint_search)",

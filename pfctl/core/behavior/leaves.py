@@ -34,7 +34,7 @@ from pfctl.core.control import sweep_pan
 from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.regions import WaypointDecision
 from pfctl.core.perception.viewpoints import face_viewpoint, nearest_viewpoint
-from pfctl.core.robot import wrap_angle
+from pfctl.core.robot import HeadState, wrap_angle
 from pfctl.core.search.next_look import Look, rank_looks
 
 
@@ -417,7 +417,7 @@ class WaypointSearch(Action):
             ),
         ),
     )
-    reads = (*Leaf.reads, "candidate", "stranger")
+    reads = (*Leaf.reads, "candidate", "stranger", "head")
     writes = ("waypoint",)
 
     REPLAN_S: ClassVar[float] = 3.0
@@ -466,6 +466,10 @@ class WaypointSearch(Action):
     #: A glanced-at person this far off the base's heading or less is looked at with the head
     #: alone; farther, the base turns toward them too, rad.
     GLANCE_ALIGNED: ClassVar[float] = 0.3
+    #: ``glance_s`` counts from when the camera points this near them, rad (well inside any
+    #: camera's half field of view); turning there may take ``GLANCE_TURN_S`` more at most.
+    GLANCE_ON: ClassVar[float] = 0.3
+    GLANCE_TURN_S: ClassVar[float] = 5.0
 
     def initialise(self) -> None:
         self._start = self.t
@@ -492,6 +496,8 @@ class WaypointSearch(Action):
         """The candidate, the place to see them from that the robot last reached, and when."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
+        self._glance_on: dict[int, float] = {}
+        """When the camera first pointed at each of them."""
 
     def _approach_candidate(self) -> bool:
         """Go up to a standing person who may be her (blackboard ``candidate``: her clothes,
@@ -556,25 +562,32 @@ class WaypointSearch(Action):
     def _glance_at_stranger(self) -> bool:
         """Look at a person standing in sight whom no camera frame has shown yet (blackboard
         ``stranger``: the laser's legs alone): stop, and turn the base toward them while the
-        head turns, for at most ``glance_s`` per person. The head alone pans at 1 rad/s, so from
-        looking behind it takes 4 s. Traced, house seed 43: her legs stood 1.5 m off past the
-        office's bookshelf; the gaze turned the head toward them from behind, and the search
-        drove on to its next place before the camera got there. Once a frame shows the person,
-        they are no stranger: their clothes (then a candidate) or their face decide. The search
-        then goes on with the way-point or look it had: a fresh choice would drop the hysteresis
-        that keeps it (traced, ``pfctl search`` over ROS, house seed 2: a line of sight grazing
-        the living room's door jamb made her legs a stranger for one tick, 1 m short of the
-        door; the search chose afresh, went to the hall, and did not find her in 60 s). False
-        when there is no such person."""
+        head turns, for ``glance_s`` per person from when the camera (the base's heading plus
+        the head's pan, blackboard ``head``) points within ``GLANCE_ON`` of them. The head pans
+        at 1 rad/s, so from looking behind the turn takes up to 4 s; it may take
+        ``GLANCE_TURN_S``. Traced, house seed 43: her legs stood 1.5 m off past the office's
+        bookshelf, and the search drove on before the camera got there; house seed 1: a glance
+        timed from its start ended with the head still 1.4 rad off her. Once a frame shows the
+        person, they are no stranger: their clothes (then a candidate) or their face decide.
+        The search then goes on with the way-point or look it had: a fresh choice would drop
+        the hysteresis that keeps it (traced, ``pfctl search`` over ROS: a line of sight
+        grazing a door's jamb made her legs a stranger for one tick, and the search chose
+        another room). False when there is no such person."""
         s: TargetState | None = self.bb.stranger
         seconds = float(self.params["glance_s"])
         if s is None or seconds <= 0.0 or math.hypot(s.vx, s.vy) >= self.STANDING:
             return False
-        if self.t - self._glanced.setdefault(s.track_id, self.t) >= seconds:
-            return False
+        began = self._glanced.setdefault(s.track_id, self.t)
         pose = self.bb.pose
+        bearing = math.atan2(s.y - pose.y, s.x - pose.x)
+        head: HeadState | None = self.bb.head
+        if head is None or abs(wrap_angle(bearing - pose.theta - head.pan)) <= self.GLANCE_ON:
+            self._glance_on.setdefault(s.track_id, self.t)
+        on = self._glance_on.get(s.track_id, math.inf)
+        if self.t - on >= seconds or self.t - began >= self.GLANCE_TURN_S + seconds:
+            return False
         self.intents.look_at(s.xy, "stranger")
-        off = wrap_angle(math.atan2(s.y - pose.y, s.x - pose.x) - pose.theta)
+        off = wrap_angle(bearing - pose.theta)
         if abs(off) > self.GLANCE_ALIGNED:
             self.intents.turn(math.copysign(self.intents.control.max_angular_speed, off))
         else:

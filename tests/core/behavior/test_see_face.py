@@ -81,7 +81,7 @@ class Rig:
             None,
             None,
         )
-        self.bb.stranger = None
+        self.bb.stranger, self.bb.head = None, None
 
     def tick(self, t: float, candidate: TargetState | None, pose: Pose2D) -> Status:
         self.bb.t, self.bb.pose, self.bb.candidate = t, pose, candidate

@@ -20,7 +20,7 @@ from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
-from pfctl.core.robot import Pose2D
+from pfctl.core.robot import HeadState, Pose2D
 from pfctl.core.search.next_look import STEP_IN
 from pfctl.core.search.whereabouts import Whereabouts
 from tests.core.behavior.test_see_face import Rig as LeafRig
@@ -191,6 +191,40 @@ def test_a_person_the_camera_has_not_seen_is_glanced_at_base_turning_then_left()
     assert rig.leaf._glance_at_stranger()
     rig.leaf.params.update(glance_s=0.0)  # missions/trees/paper_literal.yaml
     rig.bb.stranger = TargetState(12, 1.0, 4.0, 0.0, 0.0, 0.0)
+    assert not rig.leaf._glance_at_stranger()
+
+
+def test_a_glance_counts_from_when_the_camera_points_at_them() -> None:
+    """House seed 1 (this VM): the head looked behind at the belief when her legs appeared
+    2.3 m off past the office's bookshelf; 3 s after the glance began the head was still
+    1.4 rad off her and the glance ended with the camera on the wall. ``glance_s`` counts from
+    when the camera (base heading + pan) points within ``GLANCE_ON`` of them; the turn there may
+    take ``GLANCE_TURN_S`` more."""
+    rig = Rig()
+    glance_s = rig.leaf.params["glance_s"]
+    her = TargetState(9, 3.0, 3.0, 0.0, 0.0, 0.0)  # 2 m ahead of the base
+    rig.bb.stranger, rig.bb.pose = her, Pose2D(1.0, 3.0, 0.0)
+    rig.bb.t, rig.bb.head = 0.0, HeadState(pan=-2.5)  # the head looks behind
+    assert rig.leaf._glance_at_stranger()
+    assert rig.intents.stops == 1 and rig.intents.turns == []  # the base faces her already
+    rig.bb.t, rig.bb.head = glance_s + 0.1, HeadState(pan=-0.6)  # still turning toward her
+    assert rig.leaf._glance_at_stranger()
+    on = glance_s + 0.5
+    rig.bb.t, rig.bb.head = on, HeadState(pan=-0.2)  # the camera on her
+    assert rig.leaf._glance_at_stranger()
+    rig.bb.t = on + glance_s - 0.1
+    assert rig.leaf._glance_at_stranger()
+    rig.bb.t = on + glance_s + 0.1  # no frame has shown her in glance_s: on with the search
+    assert not rig.leaf._glance_at_stranger()
+    # someone the camera never comes to point at is left after GLANCE_TURN_S + glance_s
+    other = TargetState(10, 1.0, 5.0, 0.0, 0.0, 0.0)
+    start = 100.0
+    rig.bb.stranger, rig.bb.head = other, HeadState(pan=-2.5)
+    rig.bb.t = start
+    assert rig.leaf._glance_at_stranger()
+    rig.bb.t = start + WaypointSearch.GLANCE_TURN_S + glance_s - 0.1
+    assert rig.leaf._glance_at_stranger()
+    rig.bb.t = start + WaypointSearch.GLANCE_TURN_S + glance_s + 0.1
     assert not rig.leaf._glance_at_stranger()
 
 
