@@ -405,7 +405,7 @@ class WaypointSearch(Action):
                 "glance_s",
                 3.0,
                 "stop and turn to a person standing in sight whom the camera has not seen yet,"
-                " for at most this long each, s (0: never)",
+                " for this long each from when the camera points at them, s (0: never)",
                 minimum=0.0,
             ),
             param(
@@ -564,7 +564,7 @@ class WaypointSearch(Action):
         ``stranger``: the laser's legs alone): stop, and turn the base toward them while the
         head turns, for ``glance_s`` per person from when the camera (the base's heading plus
         the head's pan, blackboard ``head``) points within ``GLANCE_ON`` of them. The head pans
-        at 1 rad/s, so from looking behind the turn takes up to 4 s; it may take
+        at 1 rad/s, so from looking behind the turn takes up to 4 s; it is given
         ``GLANCE_TURN_S``. Traced, house seed 43: her legs stood 1.5 m off past the office's
         bookshelf, and the search drove on before the camera got there; house seed 1: a glance
         timed from its start ended with the head still 1.4 rad off her. Once a frame shows the
