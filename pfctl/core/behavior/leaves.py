@@ -463,6 +463,18 @@ class WaypointSearch(Action):
     #: At the place to see them from this long with no face decided, s: they face away, and
     #: the robot goes round to the side they face.
     APPROACH_LOOK_S: ClassVar[float] = 2.0
+    #: The way round to their front does not count against ``approach_s``, for this long at
+    #: most, s.
+    APPROACH_ROUND_S: ClassVar[float] = 20.0
+    #: A new candidate track this near where an approached one stood, m, within this long,
+    #: s, is the same person (:meth:`_approach_key`).
+    APPROACH_SAME_PLACE: ClassVar[float] = 0.5
+    APPROACH_SAME_S: ClassVar[float] = 10.0
+    #: The head aims at their torso (the control's look height) from ``APPROACH_TO`` m and
+    #: farther, at this height on them from ``APPROACH_MIN`` m and nearer, and in between at a
+    #: height in proportion, m: with the house's camera (45° vertical field of view), nearer
+    #: than about 1.3 m a camera aimed at the torso cuts the face off.
+    APPROACH_FACE_HEIGHT: ClassVar[float] = 1.55
     #: A glanced-at person this far off the base's heading or less is looked at with the head
     #: alone; farther, the base turns toward them too, rad.
     GLANCE_ALIGNED: ClassVar[float] = 0.3
@@ -494,6 +506,13 @@ class WaypointSearch(Action):
         """The candidate's track, when its place to be seen from was chosen, and the place."""
         self._approach_reached: tuple[int, tuple[float, float], float] | None = None
         """The candidate, the place to see them from that the robot last reached, and when."""
+        self._approach_round: dict[int, tuple[float, float]] = {}
+        """When the way round to each candidate's front began, and when it ended (inf: not
+        yet)."""
+        self._approach_alias: dict[int, int] = {}
+        """Each candidate track's approach key (:meth:`_approach_key`)."""
+        self._approach_at: dict[int, tuple[tuple[float, float], float]] = {}
+        """Where each approach key's candidate stood standing last, and when."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
         self._glance_on: dict[int, float] = {}
@@ -513,19 +532,28 @@ class WaypointSearch(Action):
         laundry's door, and the robot looked at her back until it gave up). ``approach_s``
         per person counts from when the robot is within ``APPROACH_NEAR`` of them (traced,
         home 41: 15 s went on the way there, across the room), and the way there may take
-        ``APPROACH_TRAVEL_S`` more. A walker is not chased (they walk on; the search's gaze
-        keeps them in sight as it can). False (nothing done) when there is no such person."""
+        ``APPROACH_TRAVEL_S`` more; the way round to their front does not count
+        (:meth:`_going_round`). The head aims higher up them the nearer the robot is
+        (:meth:`_candidate_look_height`). A person on a re-created track is the same person
+        (:meth:`_approach_key`). A walker is not chased (they walk on; the search's gaze keeps
+        them in sight as it can). False (nothing done) when there is no such person."""
         c: TargetState | None = self.bb.candidate
         seconds = float(self.params["approach_s"])
-        if c is None or seconds <= 0.0 or math.hypot(c.vx, c.vy) >= self.STANDING:
+        if c is None or seconds <= 0.0:
             return False
-        track = c.track_id
+        track = self._approach_key(c)
+        if track is None:
+            return False
         began = self._approached.setdefault(track, self.t)
         pose = self.bb.pose
         if math.dist((pose.x, pose.y), c.xy) <= self.APPROACH_NEAR:
             self._approach_near.setdefault(track, self.t)
         near = self._approach_near.get(track, math.inf)
-        if self.t - near >= seconds or self.t - began >= self.APPROACH_TRAVEL_S + seconds:
+        round_ = self._going_round(track)
+        if (
+            self.t - near - round_ >= seconds
+            or self.t - began - round_ >= self.APPROACH_TRAVEL_S + seconds
+        ):
             return False
         reached = self._approach_reached
         there = reached[1] if reached is not None and reached[0] == track else None
@@ -536,15 +564,16 @@ class WaypointSearch(Action):
             and self.t - reached[2] >= self.APPROACH_LOOK_S
         ):
             self._approach_facing[track] = math.atan2(c.y - there[1], c.x - there[0])
+            self._approach_round[track] = (self.t, math.inf)
             self._approach_place = None  # go round now
         place = self._approach_place
         if place is None or place[0] != track or self.t - place[1] >= self.APPROACH_REPLAN_S:
-            found = self._approach_viewpoint(c)
+            found = self._approach_viewpoint(c, track)
             if found is None:
                 self._approached[track] = -math.inf  # no place to see them from
                 return False
             place = self._approach_place = (track, self.t, found)
-        self.intents.look_at(c.xy, "candidate")  # the torso: the whole person and the face in view
+        self.intents.look_at(c.xy, "candidate", self._candidate_look_height(c))
         goal = place[2]
         if there is not None and math.dist(there, goal) <= self.APPROACH_KEEP:
             self.intents.stop()  # there already: a new place this near is not driven to
@@ -556,8 +585,68 @@ class WaypointSearch(Action):
             return False
         if outcome == "arrived":
             self._approach_reached = (track, goal, self.t)
+            round_ = self._approach_round.get(track)
+            if round_ is not None and math.isinf(round_[1]):
+                self._approach_round[track] = (round_[0], self.t)
             self.intents.stop()
         return True
+
+    def _approach_key(self, c: TargetState) -> int | None:
+        """The track under which candidate ``c``'s approach is kept, or None for a walker (not
+        gone up to). The key is their own track, or, for a new track within
+        ``APPROACH_SAME_PLACE`` m of where an approached candidate stood in the last
+        ``APPROACH_SAME_S`` s, that candidate's: the same person on a re-created track. A
+        candidate near where they stood counts as standing whatever their track's speed says.
+        Traced, house seed 30: a walker passing her pulled her track's speed over
+        ``STANDING`` for a second, then took the track away; her new track began the approach
+        afresh, from the side she was not facing."""
+        standing = math.hypot(c.vx, c.vy) < self.STANDING
+        key = self._approach_alias.get(c.track_id)
+        if key is None:
+            key = c.track_id
+            if key not in self._approached:
+                key = next(
+                    (
+                        k
+                        for k, (xy, t) in self._approach_at.items()
+                        if self.t - t <= self.APPROACH_SAME_S
+                        and math.dist(xy, c.xy) <= self.APPROACH_SAME_PLACE
+                    ),
+                    key,
+                )
+            if not standing and key == c.track_id:
+                return None  # a walker, not seen standing yet
+            self._approach_alias[c.track_id] = key
+        stood = self._approach_at.get(key)
+        if standing:
+            self._approach_at[key] = (c.xy, self.t)
+        elif stood is None or math.dist(stood[0], c.xy) > self.APPROACH_SAME_PLACE:
+            return None  # walked off: not chased
+        return key
+
+    def _going_round(self, track: int) -> float:
+        """How long the way round to candidate ``track``'s front took (so far), s, at most
+        ``APPROACH_ROUND_S``: it does not count against ``approach_s``. Traced, house seed 30:
+        she stood facing a corner 1 m off; the robot looked at her back from 2 m, and the way
+        round, 2.6 m at walking pace, used up what was left of 15 s before it got there."""
+        round_ = self._approach_round.get(track)
+        if round_ is None:
+            return 0.0
+        return min(min(round_[1], self.t) - round_[0], self.APPROACH_ROUND_S)
+
+    def _candidate_look_height(self, c: TargetState) -> float | None:
+        """The height on candidate ``c`` to aim the head at (None: the torso, the control's
+        look height): from ``APPROACH_TO`` m away the torso keeps the whole person and the
+        face in the frame; nearer, the aim rises toward ``APPROACH_FACE_HEIGHT``, reached at
+        ``APPROACH_MIN`` (traced, house seed 30: 0.9 m from her, aimed at her torso, the
+        frame's top edge was at her shoulders)."""
+        pose = self.bb.pose
+        d = math.dist((pose.x, pose.y), c.xy)
+        if d >= self.APPROACH_TO:
+            return None
+        torso = self.intents.control.look_height
+        share = min((self.APPROACH_TO - d) / (self.APPROACH_TO - self.APPROACH_MIN), 1.0)
+        return torso + share * (self.APPROACH_FACE_HEIGHT - torso)
 
     def _glance_at_stranger(self) -> bool:
         """Look at a person standing in sight whom no camera frame has shown yet (blackboard
@@ -594,11 +683,12 @@ class WaypointSearch(Action):
             self.intents.stop()
         return True
 
-    def _approach_viewpoint(self, c: TargetState) -> tuple[float, float] | None:
-        """Where to see candidate ``c`` from: in front of them once they showed the robot no
-        face (:meth:`_approach_candidate`), if there is such a place; else the nearest."""
+    def _approach_viewpoint(self, c: TargetState, key: int) -> tuple[float, float] | None:
+        """Where to see candidate ``c`` (approached as ``key``) from: in front of them once
+        they showed the robot no face (:meth:`_approach_candidate`), if there is such a place;
+        else the nearest."""
         pose = self.bb.pose
-        facing = self._approach_facing.get(c.track_id)
+        facing = self._approach_facing.get(key)
         if facing is not None:
             front = face_viewpoint(
                 self.world.planner,

@@ -13,6 +13,7 @@ from py_trees.common import Access, Status
 
 from pfctl.core.behavior.blackboard import KEYS, TargetState, new_namespace
 from pfctl.core.behavior.leaves import Leaf, SeeFace
+from pfctl.core.control import ControlParams
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.robot import Pose2D
@@ -36,7 +37,7 @@ class Intents:
         self.looks: list[tuple[tuple[float, float], str, float | None]] = []
         self.turns: list[float] = []
         self.nav = "running"
-        self.control = SimpleNamespace(max_angular_speed=0.8)
+        self.control = ControlParams()
 
     def claim(self, action: str) -> None:
         pass

@@ -67,13 +67,21 @@ def test_a_standing_candidate_is_gone_up_to_head_on_them_then_left_after_a_while
     short = Pose2D(goal[0] - 0.12, goal[1])
     assert rig.approach(5.0 + WaypointSearch.APPROACH_REPLAN_S, her, short) and rig.stops == 2
     assert len(rig.intents.goals) == sent
-    # her face never turned to the robot: approach_s after it came near, the search goes on
+    # no face: APPROACH_LOOK_S after it got there, the robot goes round to her front; it
+    # gets there 5 s later, and her face never turns to it
+    round_from = 5.0 + WaypointSearch.APPROACH_LOOK_S
+    assert rig.approach(round_from, her, Pose2D(*goal))
+    front = rig.intents.goals[-1]
+    assert front[0] > her.x
+    rig.intents.nav = "arrived"
+    assert rig.approach(round_from + 5.0, her, Pose2D(*front))
+    # approach_s after it came near, less the way round, the search goes on
     near = 5.0  # APPROACH_NEAR was first reached at the place (the robot was 5 m off at 0 s)
-    assert rig.approach(near + APPROACH_S - 0.1, her, Pose2D(*goal))
-    assert not rig.approach(near + APPROACH_S + 0.1, her, Pose2D(*goal))
+    assert rig.approach(near + APPROACH_S + 5.0 - 0.1, her, Pose2D(*front))
+    assert not rig.approach(near + APPROACH_S + 5.0 + 0.1, her, Pose2D(*front))
     someone_else = TargetState(5, 6.0, 1.0, 0.0, 0.0, 0.0)
     rig.intents.nav = "running"
-    assert rig.approach(near + APPROACH_S + 0.2, someone_else, Pose2D(*goal))
+    assert rig.approach(near + APPROACH_S + 5.2, someone_else, Pose2D(*front))
 
 
 def test_a_candidate_who_shows_no_face_is_seen_from_in_front() -> None:
@@ -98,7 +106,7 @@ def test_a_candidate_who_shows_no_face_is_seen_from_in_front() -> None:
     assert abs(math.atan2(front[1] - her.y, front[0] - her.x)) <= math.radians(60) + 1e-6
     dist = math.dist(front, her.xy)
     assert WaypointSearch.APPROACH_MIN <= dist <= WaypointSearch.APPROACH_TO + 1e-9
-    assert rig.intents.looks[-1] == (her.xy, "candidate", None)
+    assert rig.intents.looks[-1][:2] == (her.xy, "candidate")
 
 
 def test_the_way_up_to_a_candidate_does_not_count_against_approach_s() -> None:
@@ -139,6 +147,63 @@ def test_she_is_gone_up_to_where_she_is_in_sight_not_through_a_wall() -> None:
     goal = rig.intents.goals[-1]
     assert goal[0] > 4.1  # through the door, on her side of the wall
     assert math.dist(goal, her.xy) <= WaypointSearch.APPROACH_TO + 1e-9
+
+
+def test_the_way_round_to_her_front_counts_against_approach_s_for_a_while_only() -> None:
+    """House seed 30: she stood facing a corner; the way round to her front took the rest of
+    ``approach_s``. It does not count, for ``APPROACH_ROUND_S`` at most."""
+    rig = Rig()
+    her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
+    rig.intents.nav = "arrived"
+    assert rig.approach(0.0, her, Pose2D(3.0, 3.0))  # near at once, and there
+    rig.intents.nav = "running"
+    assert rig.approach(WaypointSearch.APPROACH_LOOK_S, her, Pose2D(3.0, 3.0))  # round now
+    bound = APPROACH_S + WaypointSearch.APPROACH_ROUND_S
+    assert rig.approach(bound - 0.1, her, Pose2D(4.0, 4.5))  # still on the way round
+    assert not rig.approach(bound + 0.1, her, Pose2D(4.0, 4.5))
+
+
+def test_nearer_a_candidate_the_head_aims_higher_up_to_the_face() -> None:
+    """House seed 30: 0.9 m from her, the head aimed at her torso, the frame's top edge was at
+    her shoulders. From ``APPROACH_TO`` m on the aim rises to ``APPROACH_FACE_HEIGHT`` at
+    ``APPROACH_MIN``."""
+    rig = Rig()
+    her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
+    heights = []
+    for d in (3.0, WaypointSearch.APPROACH_TO, 1.6, WaypointSearch.APPROACH_MIN, 0.8):
+        assert rig.approach(0.0, her, Pose2D(5.0 - d, 3.0))
+        heights.append(rig.intents.looks[-1][2])
+    torso = rig.intents.control.look_height
+    assert heights[:2] == [None, None]
+    assert torso < heights[2] < WaypointSearch.APPROACH_FACE_HEIGHT
+    assert heights[3] == heights[4] == pytest.approx(WaypointSearch.APPROACH_FACE_HEIGHT)
+
+
+def test_her_new_track_where_she_stood_goes_on_with_her_approach() -> None:
+    """House seed 30: a walker passing her pulled her track's speed up for a second, then took
+    the track away; her new track began afresh, from the side she did not face. A candidate
+    near where she stood counts as standing, and a new track there goes on with her approach:
+    to the front it was going round to, on the time it had."""
+    rig = Rig()
+    her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
+    rig.intents.nav = "arrived"
+    assert rig.approach(0.0, her, Pose2D(3.0, 3.0))
+    rig.intents.nav = "running"
+    assert rig.approach(WaypointSearch.APPROACH_LOOK_S, her, Pose2D(3.0, 3.0))
+    front = rig.intents.goals[-1]
+    assert front[0] > her.x
+    jostled = TargetState(4, 5.2, 3.1, 0.5, 0.0, 0.0)  # her track, pulled by a passer-by
+    assert rig.approach(3.0, jostled, Pose2D(3.5, 2.5))
+    new_track = TargetState(9, 5.05, 3.0, 0.05, 0.0, 0.0)
+    assert rig.approach(4.0, new_track, Pose2D(4.0, 2.2))
+    goal = rig.intents.goals[-1]  # still round to her front, the side she faces
+    assert abs(math.atan2(goal[1] - her.y, goal[0] - her.x)) <= math.radians(60) + 1e-6
+    assert rig.intents.looks[-1][:2] == (new_track.xy, "candidate")
+    # the old track walks off with the passer-by: no longer gone after
+    assert not rig.approach(5.0, TargetState(4, 6.0, 3.5, 0.6, 0.0, 0.0), Pose2D(4.0, 2.2))
+    # the time left is her approach's, not a new track's
+    bound = APPROACH_S + WaypointSearch.APPROACH_ROUND_S
+    assert not rig.approach(bound + 0.1, new_track, Pose2D(4.0, 2.2))
 
 
 def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
