@@ -149,7 +149,7 @@ def test_she_is_gone_up_to_where_she_is_in_sight_not_through_a_wall() -> None:
     assert math.dist(goal, her.xy) <= WaypointSearch.APPROACH_TO + 1e-9
 
 
-def test_the_way_round_to_her_front_counts_against_approach_s_for_a_while_only() -> None:
+def test_the_way_round_to_her_front_does_not_count_against_approach_s_for_a_while() -> None:
     """House seed 30: she stood facing a corner; the way round to her front took the rest of
     ``approach_s``. It does not count, for ``APPROACH_ROUND_S`` at most."""
     rig = Rig()
