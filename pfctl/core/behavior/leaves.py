@@ -37,6 +37,9 @@ from pfctl.core.perception.viewpoints import face_viewpoint, nearest_viewpoint
 from pfctl.core.robot import HeadState, wrap_angle
 from pfctl.core.search.next_look import Look, rank_looks
 
+#: Height of a standing person's face, m: where the head aims to see it.
+FACE_HEIGHT = 1.55
+
 
 class Leaf(py_trees.behaviour.Behaviour):
     """A leaf with its resolved parameters and a blackboard client in the follower's namespace.
@@ -474,7 +477,7 @@ class WaypointSearch(Action):
     #: farther, at this height on them from ``APPROACH_MIN`` m and nearer, and in between at a
     #: height in proportion, m: with the house's camera (45° vertical field of view), nearer
     #: than about 1.3 m a camera aimed at the torso cuts the face off.
-    APPROACH_FACE_HEIGHT: ClassVar[float] = 1.55
+    APPROACH_FACE_HEIGHT: ClassVar[float] = FACE_HEIGHT
     #: A glanced-at person this far off the base's heading or less is looked at with the head
     #: alone; farther, the base turns toward them too, rad.
     GLANCE_ALIGNED: ClassVar[float] = 0.3
@@ -512,7 +515,7 @@ class WaypointSearch(Action):
         self._approach_alias: dict[int, int] = {}
         """Each candidate track's approach key (:meth:`_approach_key`)."""
         self._approach_at: dict[int, tuple[tuple[float, float], float]] = {}
-        """Where each approach key's candidate stood standing last, and when."""
+        """Where each approach key's candidate last stood still, and when."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
         self._glance_on: dict[int, float] = {}
@@ -1096,7 +1099,9 @@ class SeeFace(Action):
             param("range_max", 2.5, "farthest distance to them, m", minimum=1.0),
             param("timeout", 15.0, "give up after this long, s", minimum=1.0),
             param("retry_s", 30.0, "a person given up on is not tried again for this long, s"),
-            param("face_height", 1.55, "height of the face to aim the head at, m", minimum=0.5),
+            param(
+                "face_height", FACE_HEIGHT, "height of the face to aim the head at, m", minimum=0.5
+            ),
             param("aside", 20.0, "degrees off a walker's path ahead the place keeps", minimum=0.0),
             param("clearance", 0.25, "the line of sight keeps this far from walls, m"),
             param("tolerance", 0.3, "arrival distance at the place, m", minimum=0.05),
