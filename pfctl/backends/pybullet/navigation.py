@@ -20,7 +20,10 @@ longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
 seconds after the laser last showed something there; while the path goes round marked points it
 is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken when it is
 :data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment does not send
-the robot round the house. Pure numpy: no pybullet.
+the robot round the house. A goal that lies inside the marks (a person stands on or beside the
+place to look from) is planned to the nearest point free of them within
+:data:`MARKED_GOAL_TOLERANCE`, as navfn's ``default_tolerance`` does for move_base, and the robot
+arrives there: the end of its path. Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -61,6 +64,9 @@ BLOCKER_MEMORY = 4.0
 RECONSIDER_PERIOD = 2.0
 #: … and the new path is taken when it is at least this much shorter than the rest (m).
 RECONSIDER_GAIN = 1.0
+#: A goal inside the marked points is planned to the nearest point free of them within this,
+#: metres (navfn's ``default_tolerance``); farther, the re-plan fails as before.
+MARKED_GOAL_TOLERANCE = 0.6
 #: The local safety layer (:func:`keep_clear`): no velocity toward a sensed point of the static
 #: map (a wall, furniture) within the robot's radius plus this, metres …
 WALL_MARGIN = 0.06
@@ -204,6 +210,19 @@ class Navigator:
             return self.planner
         return self.planner.with_obstacles(self._blockers, BLOCKER_RADIUS)
 
+    def _plan_round_marks(self, pose: Pose2D) -> np.ndarray:
+        """A path from ``pose`` on :meth:`_planner_now`'s map: to the goal, or, when the goal is
+        inside the marks, to the nearest point free of them within MARKED_GOAL_TOLERANCE.
+        Raises :class:`NoPathError` as :meth:`GridPlanner.plan` does."""
+        assert self.goal is not None
+        planner = self._planner_now()
+        goal = np.array([self.goal.x, self.goal.y])
+        if planner is not self.planner and not planner.is_free(goal):
+            near = planner.nearest_free(goal, MARKED_GOAL_TOLERANCE)
+            if near is not None:
+                goal = near
+        return planner.plan((pose.x, pose.y), goal)
+
     def _reconsider(self, pose: Pose2D, rest: float) -> None:
         """Plan again round the marks still remembered; take the path if it is RECONSIDER_GAIN
         shorter than the ``rest`` of the current one (not a re-plan: nothing blocked). With no
@@ -213,7 +232,7 @@ class Navigator:
         self._since_reconsider = 0.0
         marked = len(self._blockers) > 0
         try:
-            path = self._planner_now().plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+            path = self._plan_round_marks(pose)
         except NoPathError:
             return
         if not marked:
@@ -329,7 +348,7 @@ class Navigator:
             self._mark(blockers)
         self._since_reconsider = 0.0
         try:
-            self.path = self._planner_now().plan((pose.x, pose.y), (self.goal.x, self.goal.y))
+            self.path = self._plan_round_marks(pose)
             self._round_marks = len(self._blockers) > 0
         except NoPathError as err:
             self.reason = str(err)
@@ -358,7 +377,7 @@ class Navigator:
                 self._replan(pose, np.empty((0, 2)))
             return STOP
         xy = np.array([pose.x, pose.y])
-        goal_xy = np.array([self.goal.x, self.goal.y])
+        goal_xy = self.path[-1]  # the goal, or the point planned to beside a marked one
         to_goal = float(np.linalg.norm(goal_xy - xy))
         if to_goal <= self.goal_tolerance:
             yaw_err = _wrap(self.goal.theta - pose.theta)

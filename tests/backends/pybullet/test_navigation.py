@@ -9,6 +9,7 @@ import pytest
 import shapely
 
 from pfctl.backends.pybullet.navigation import (
+    MARKED_GOAL_TOLERANCE,
     PERSON_MARGIN,
     RECENT_PEOPLE_S,
     WALL_MARGIN,
@@ -135,6 +136,30 @@ def test_a_door_blocked_for_a_moment_is_taken_once_clear(
     through_door = (np.abs(xy[:, 1] - 4.0) < 0.15) & (xy[:, 0] > 1.9) & (xy[:, 0] < 2.7)
     assert through_door.any()
     assert len(poses) * DT < 60.0  # the kitchen door's way takes ~35 s; round the house ~75 s
+
+
+def test_a_goal_a_person_stands_on_is_reached_as_near_as_free(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """The place to look from is where a person stands (the search's look just inside a door,
+    where she is): the re-plan round her legs plans to the nearest point free of them, within
+    MARKED_GOAL_TOLERANCE, and the robot arrives there (move_base's planner tolerance) instead
+    of failing its re-plans until ABORTED."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 5.0), Pose2D(6.0, 5.0)
+    circle = np.linspace(0, 2 * np.pi, 12, endpoint=False)
+    leg = 0.06 * np.column_stack((np.cos(circle), np.sin(circle)))
+    legs = np.vstack([leg + np.array(feet) for feet in ((6.12, 5.0), (6.12, 4.8))])  # past the goal
+    nav.start(goal, start)
+    poses, _ = _drive(nav, start, 60.0, lambda pose: legs)
+    assert nav.status is NavStatus.SUCCEEDED, nav.reason
+    assert nav.total_replans >= 1  # it did plan round her
+    end = np.array([poses[-1].x, poses[-1].y])
+    assert np.linalg.norm(end - (goal.x, goal.y)) <= MARKED_GOAL_TOLERANCE + nav.goal_tolerance
+    xy = np.array([(p.x, p.y) for p in poses])
+    gap = np.linalg.norm(xy[:, None] - legs[None], axis=2).min()
+    assert gap >= planner.robot_radius + PERSON_MARGIN - 0.07  # never into her
+    assert nav.update(poses[-1], DT, legs) == Twist2D()  # done: stands still
 
 
 def test_fully_blocked_door_aborts_after_bounded_replans(
