@@ -345,7 +345,10 @@ class TargetIdentifier:
         self._key = next(_IDENTIFIERS)
         """Job keys are ``(key, n)``: several identifiers may share one worker."""
         self._given_worker = worker
-        self.distractors = DistractorMemory(link_radius=self.params.coexist_distance)
+        self.distractors = DistractorMemory(
+            link_radius=self.params.coexist_distance,
+            clothes_match=self.params.clothes_similarity,
+        )
         """The people found not to be her (issue 23, item 4)."""
         self._named: int | None = None
         """The track named the target (switched only on confirmation, :meth:`target_track`)."""
