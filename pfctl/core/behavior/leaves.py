@@ -516,6 +516,8 @@ class WaypointSearch(Action):
         """Each candidate track's approach key (:meth:`_approach_key`)."""
         self._approach_at: dict[int, tuple[tuple[float, float], float]] = {}
         """Where each approach key's candidate last stood still, and when."""
+        self._approach_front: dict[int, tuple[tuple[float, float], tuple[float, float]]] = {}
+        """The place in front of each candidate last found, and where they stood then."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
         self._glance_on: dict[int, float] = {}
@@ -689,7 +691,12 @@ class WaypointSearch(Action):
     def _approach_viewpoint(self, c: TargetState, key: int) -> tuple[float, float] | None:
         """Where to see candidate ``c`` (approached as ``key``) from: in front of them once
         they showed the robot no face (:meth:`_approach_candidate`), if there is such a place;
-        else the nearest."""
+        else the nearest. A place in front found once is kept while they stand within
+        ``APPROACH_SAME_PLACE`` of where they stood then, though it is not found again: traced,
+        crowd seed 1, she stood facing a corner, and the only place in front of her lay at
+        ``APPROACH_MIN``; her track's few centimetres of jitter took it in and out of reach,
+        and each time it was out the robot chose the nearest place, where it stood, and
+        stopped there, her back to it, until ``approach_s`` ran out."""
         pose = self.bb.pose
         facing = self._approach_facing.get(key)
         if facing is not None:
@@ -703,7 +710,11 @@ class WaypointSearch(Action):
                 clearance=self.APPROACH_CLEARANCE,
             )
             if front is not None:
+                self._approach_front[key] = (front.xy, c.xy)
                 return front.xy
+            kept = self._approach_front.get(key)
+            if kept is not None and math.dist(kept[1], c.xy) <= self.APPROACH_SAME_PLACE:
+                return kept[0]
         found = nearest_viewpoint(
             self.world.planner,
             (pose.x, pose.y),

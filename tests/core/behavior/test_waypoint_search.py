@@ -20,6 +20,7 @@ from pfctl.core.mapping.frontiers import FrontierCluster
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams, WaypointDecision
+from pfctl.core.perception.viewpoints import face_viewpoint
 from pfctl.core.robot import HeadState, Pose2D
 from pfctl.core.search.next_look import STEP_IN
 from pfctl.core.search.whereabouts import Whereabouts
@@ -204,6 +205,45 @@ def test_her_new_track_where_she_stood_goes_on_with_her_approach() -> None:
     # the time left is her approach's, not a new track's
     bound = APPROACH_S + WaypointSearch.APPROACH_ROUND_S
     assert not rig.approach(bound + 0.1, new_track, Pose2D(4.0, 2.2))
+
+
+def test_a_place_in_front_of_her_found_once_is_kept_while_she_stands_there() -> None:
+    """Crowd seed 1: she stood facing a corner; the only place in front of her lay at
+    APPROACH_MIN, and her track's jitter took it in and out of reach. Each time it was out,
+    the robot chose the nearest place, where it stood, and stopped with her back to it until
+    approach_s ran out. The front found once is kept while she stands where she stood."""
+    rig = Rig()
+    her = TargetState(4, 7.18, 3.0, 0.0, 0.0, 0.0)  # facing east, 0.5 m from the east wall
+    robot = Pose2D(5.0, 3.0)
+    rig.intents.nav = "arrived"
+    assert rig.approach(0.0, her, robot)  # at the nearest place already, her back to it
+    rig.intents.nav = "running"
+    assert rig.approach(WaypointSearch.APPROACH_LOOK_S, her, robot)
+    front = rig.intents.goals[-1]
+    assert abs(math.atan2(front[1] - her.y, front[0] - her.x)) <= math.radians(62)  # ~east
+    stops = rig.stops
+    on_the_way = Pose2D(6.0, 3.8)
+    jittered = TargetState(4, 7.26, 3.0, 0.0, 0.0, 0.0)  # 8 cm east
+    facing = rig.leaf._approach_facing[4]
+    assert (  # the premise: from there, no place in front of her is found
+        face_viewpoint(
+            rig.bb.world.planner,
+            (on_the_way.x, on_the_way.y),
+            jittered.xy,
+            facing,
+            WaypointSearch.APPROACH_MIN,
+            WaypointSearch.APPROACH_TO,
+            clearance=WaypointSearch.APPROACH_CLEARANCE,
+        )
+        is None
+    )
+    t = WaypointSearch.APPROACH_LOOK_S + WaypointSearch.APPROACH_REPLAN_S
+    assert rig.approach(t, jittered, on_the_way)
+    assert rig.intents.goals[-1] == front and rig.stops == stops  # on round to her front
+    # she stands elsewhere now: the front is found anew or the nearest place taken
+    moved = TargetState(4, 6.5, 2.4, 0.0, 0.0, 0.0)
+    assert rig.approach(t + 0.4 + WaypointSearch.APPROACH_REPLAN_S, moved, on_the_way)
+    assert rig.intents.goals[-1] != front
 
 
 def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
