@@ -17,7 +17,7 @@ mission's layout.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from typing import Any, ClassVar
 
@@ -464,8 +464,12 @@ class WaypointSearch(Action):
     APPROACH_NEAR: ClassVar[float] = 3.0
     APPROACH_TRAVEL_S: ClassVar[float] = 40.0
     #: At the place to see them from this long with no face decided, s: they face away, and
-    #: the robot goes round to the side they face.
+    #: the robot goes round to the side they face — and on round them, a side at a time, while
+    #: no face decides.
     APPROACH_LOOK_S: ClassVar[float] = 2.0
+    #: Places in front of them this near head-on, rad, are taken before the rest of
+    #: ``face_viewpoint``'s 60° (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`).
+    APPROACH_HEAD_ON: ClassVar[float] = math.radians(30.0)
     #: The way round to their front does not count against ``approach_s``, for this long at
     #: most, s.
     APPROACH_ROUND_S: ClassVar[float] = 20.0
@@ -505,6 +509,8 @@ class WaypointSearch(Action):
         """When the robot first came within ``APPROACH_NEAR`` of each candidate."""
         self._approach_facing: dict[int, float] = {}
         """The way a candidate who showed the robot no face is taken to face (rad)."""
+        self._approach_looked: dict[int, list[tuple[float, float]]] = {}
+        """The places each candidate was looked at from, ``APPROACH_LOOK_S`` with no face."""
         self._approach_place: tuple[int, float, tuple[float, float]] | None = None
         """The candidate's track, when its place to be seen from was chosen, and the place."""
         self._approach_reached: tuple[int, tuple[float, float], float] | None = None
@@ -562,14 +568,17 @@ class WaypointSearch(Action):
             return False
         reached = self._approach_reached
         there = reached[1] if reached is not None and reached[0] == track else None
+        looked = self._approach_looked.setdefault(track, [])
         if (
             there is not None
             and reached is not None
-            and track not in self._approach_facing
             and self.t - reached[2] >= self.APPROACH_LOOK_S
+            and all(math.dist(there, p) > self.APPROACH_KEEP for p in looked)
         ):
-            self._approach_facing[track] = math.atan2(c.y - there[1], c.x - there[0])
-            self._approach_round[track] = (self.t, math.inf)
+            looked.append(there)
+            self._approach_facing[track] = _unlooked_side(c.xy, looked)
+            self._approach_front.pop(track, None)
+            self._start_round(track)
             self._approach_place = None  # go round now
         place = self._approach_place
         if place is None or place[0] != track or self.t - place[1] >= self.APPROACH_REPLAN_S:
@@ -628,6 +637,15 @@ class WaypointSearch(Action):
         elif stood is None or math.dist(stood[0], c.xy) > self.APPROACH_SAME_PLACE:
             return None  # walked off: not chased
         return key
+
+    def _start_round(self, track: int) -> None:
+        """The way round to candidate ``track``'s front (or on to another side) begins now;
+        the time of any way round before it goes on counting (:meth:`_going_round`)."""
+        round_ = self._approach_round.get(track)
+        if round_ is None:
+            self._approach_round[track] = (self.t, math.inf)
+        elif math.isfinite(round_[1]):
+            self._approach_round[track] = (self.t - (round_[1] - round_[0]), math.inf)
 
     def _going_round(self, track: int) -> float:
         """How long the way round to candidate ``track``'s front took (so far), s, at most
@@ -691,15 +709,21 @@ class WaypointSearch(Action):
     def _approach_viewpoint(self, c: TargetState, key: int) -> tuple[float, float] | None:
         """Where to see candidate ``c`` (approached as ``key``) from: in front of them once
         they showed the robot no face (:meth:`_approach_candidate`), if there is such a place;
-        else the nearest. A place in front found once is kept while they stand within
-        ``APPROACH_SAME_PLACE`` of where they stood then, though it is not found again: traced,
-        crowd seed 1, she stood facing a corner, and the only place in front of her lay at
-        ``APPROACH_MIN``; her track's few centimetres of jitter took it in and out of reach,
-        and each time it was out the robot chose the nearest place, where it stood, and
-        stopped there, her back to it, until ``approach_s`` ran out."""
+        else the nearest. In front, places within ``APPROACH_HEAD_ON`` of the way they face come
+        first (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`). A place in front
+        found once is kept while they stand within ``APPROACH_SAME_PLACE`` of where they stood
+        then: traced, crowd seed 1, she stood facing a corner, and the only place in front of
+        her lay at ``APPROACH_MIN``; her track's few centimetres of jitter took it in and out
+        of reach, and each time it was out the robot chose the nearest place, where it stood,
+        and stopped there, her back to it, until ``approach_s`` ran out; crowd seed 4, chosen
+        anew each second, the place went back and forth between her front and her side as the
+        robot drove."""
         pose = self.bb.pose
         facing = self._approach_facing.get(key)
         if facing is not None:
+            kept = self._approach_front.get(key)
+            if kept is not None and math.dist(kept[1], c.xy) <= self.APPROACH_SAME_PLACE:
+                return kept[0]
             front = face_viewpoint(
                 self.world.planner,
                 (pose.x, pose.y),
@@ -708,13 +732,11 @@ class WaypointSearch(Action):
                 self.APPROACH_MIN,
                 self.APPROACH_TO,
                 clearance=self.APPROACH_CLEARANCE,
+                head_on=self.APPROACH_HEAD_ON,
             )
             if front is not None:
                 self._approach_front[key] = (front.xy, c.xy)
                 return front.xy
-            kept = self._approach_front.get(key)
-            if kept is not None and math.dist(kept[1], c.xy) <= self.APPROACH_SAME_PLACE:
-                return kept[0]
         found = nearest_viewpoint(
             self.world.planner,
             (pose.x, pose.y),
@@ -947,6 +969,19 @@ class WaypointSearch(Action):
             self.intents.stop()
         self.intents.set_pan(bearing + sweep_pan(elapsed, seconds, self.LOOK_PAN), 0.0, "sweep")
         return Status.RUNNING
+
+
+def _unlooked_side(person: tuple[float, float], looked: Sequence[tuple[float, float]]) -> float:
+    """The way a person is taken to face when the robot has looked at them from ``looked``
+    and seen no face (rad, map frame): the middle of the widest angle round them between the
+    places looked from — away from the one place at first, then a side not looked from yet."""
+    bearings = sorted(math.atan2(y - person[1], x - person[0]) for x, y in looked)
+    if len(bearings) == 1:
+        return wrap_angle(bearings[0] + math.pi)
+    gap, start = max(
+        ((bearings[(k + 1) % len(bearings)] - b) % (2 * math.pi), b) for k, b in enumerate(bearings)
+    )
+    return wrap_angle(start + gap / 2.0)
 
 
 def _with_waypoint(decision: WaypointDecision, goal: tuple[float, float]) -> WaypointDecision:

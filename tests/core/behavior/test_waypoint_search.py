@@ -246,6 +246,46 @@ def test_a_place_in_front_of_her_found_once_is_kept_while_she_stands_there() -> 
     assert rig.intents.goals[-1] != front
 
 
+def _bearing_off(a: tuple[float, float], b: tuple[float, float], her: TargetState) -> float:
+    """The angle between places ``a`` and ``b`` as seen from her, rad."""
+    ba = math.atan2(a[1] - her.y, a[0] - her.x)
+    bb = math.atan2(b[1] - her.y, b[0] - her.x)
+    return abs((ba - bb + math.pi) % (2 * math.pi) - math.pi)
+
+
+def test_with_no_face_from_her_front_either_the_robot_goes_on_round_her() -> None:
+    """Crowd seed 4: she stood facing south-west; the robot looked at her back, went round to
+    where it took her front to be, saw no face there either, and stood there 10 s until the
+    approach ran out. With no face from a place either, it goes on round her, to the side
+    farthest from every place it has looked from, until her face decides or the time is up."""
+    rig = Rig()
+    her = TargetState(4, 4.0, 3.0, 0.0, 0.0, 0.0)
+    rig.intents.nav = "arrived"
+    assert rig.approach(0.0, her, Pose2D(2.0, 3.0))  # west of her, there at once
+    rig.intents.nav = "running"
+    assert rig.approach(WaypointSearch.APPROACH_LOOK_S, her, Pose2D(2.0, 3.0))
+    front = rig.intents.goals[-1]
+    assert front[0] > her.x  # round to the east
+    # straight in front of her as far as a place within APPROACH_HEAD_ON allows
+    assert _bearing_off(front, (5.0, 3.0), her) <= WaypointSearch.APPROACH_HEAD_ON + 1e-6
+    at = 2.0 + WaypointSearch.APPROACH_LOOK_S  # the robot is there 2 s later
+    rig.intents.nav = "arrived"
+    assert rig.approach(at, her, Pose2D(*front))
+    sent = len(rig.intents.goals)
+    rig.intents.nav = "running"
+    assert rig.approach(at + WaypointSearch.APPROACH_LOOK_S - 0.1, her, Pose2D(*front))
+    assert len(rig.intents.goals) == sent  # still looking from her front
+    assert rig.approach(at + WaypointSearch.APPROACH_LOOK_S, her, Pose2D(*front))
+    side = rig.intents.goals[-1]
+    looked = [(2.0, 3.0), front]
+    assert all(_bearing_off(side, p, her) >= math.radians(60) for p in looked)
+    assert WaypointSearch.APPROACH_MIN <= math.dist(side, her.xy) <= WaypointSearch.APPROACH_TO
+    # the time going round from side to side adds up to APPROACH_ROUND_S at most
+    bound = APPROACH_S + WaypointSearch.APPROACH_ROUND_S
+    assert rig.approach(bound - 0.1, her, Pose2D(4.0, 4.0))
+    assert not rig.approach(bound + 0.1, her, Pose2D(4.0, 4.0))
+
+
 def test_no_candidate_or_a_walker_is_not_gone_after() -> None:
     rig = Rig()
     assert not rig.approach(0.0, None, Pose2D(1.0, 3.0))

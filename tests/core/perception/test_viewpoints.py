@@ -13,7 +13,7 @@ import pytest
 from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.paths import line_of_sight
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.perception.viewpoints import nearest_viewpoint, viewpoint_mask
+from pfctl.core.perception.viewpoints import face_viewpoint, nearest_viewpoint, viewpoint_mask
 
 RES = 0.05
 RADIUS = 0.2
@@ -95,3 +95,37 @@ def test_no_place_when_she_cannot_be_reached_or_seen() -> None:
     assert nearest_viewpoint(planner, (1.0, 2.0), (6.0, 1.0), range_max=5.0) is None
     with pytest.raises(ValueError, match="range_min"):
         viewpoint_mask(planner, (6.0, 1.0), range_max=1.0, range_min=2.0)
+
+
+def _open_room() -> GridPlanner:
+    """8 m × 6 m, walled round, empty."""
+    p = np.zeros((round(6 / RES), round(8 / RES)))
+    p[:2, :] = p[-2:, :] = p[:, :2] = p[:, -2:] = 1.0
+    return GridPlanner(OccupancyGrid.from_probabilities(p, RES), RADIUS)
+
+
+def _off_facing(place: tuple[float, float], her: tuple[float, float], facing: float) -> float:
+    bearing = math.atan2(place[1] - her[1], place[0] - her[0])
+    return abs((bearing - facing + math.pi) % (2 * math.pi) - math.pi)
+
+
+def test_a_place_nearer_head_on_comes_first_where_the_robot_can_reach_one() -> None:
+    """Crowd seed 4: the cheapest place within 60° of the way she was taken to face lay about
+    50° off it, and her face was not found from there. With ``head_on``, the places within
+    that angle of her facing come first; where there are none, the rest of the 60° do."""
+    planner = _open_room()
+    her, east = (4.0, 3.0), 0.0
+    robot = (4.0, 5.5)  # at her side, north of her
+    cheapest = face_viewpoint(planner, robot, her, east, 1.0, 2.2)
+    assert cheapest is not None
+    assert _off_facing(cheapest.xy, her, east) > math.radians(40)  # the premise
+    head_on = face_viewpoint(planner, robot, her, east, 1.0, 2.2, head_on=math.radians(30))
+    assert head_on is not None
+    assert _off_facing(head_on.xy, her, east) <= math.radians(30) + 1e-9
+    assert 1.0 <= math.dist(head_on.xy, her) <= 2.2 + 1e-9
+    assert head_on.cost > cheapest.cost
+    # facing the east wall 1 m off: no place that near head-on, so one of the 60° is taken
+    at_wall = (7.0, 3.0)
+    fallback = face_viewpoint(planner, robot, at_wall, east, 1.0, 2.2, head_on=math.radians(30))
+    assert fallback is not None
+    assert math.radians(30) < _off_facing(fallback.xy, at_wall, east) <= math.radians(60) + 1e-9
