@@ -122,16 +122,25 @@ class DistractorMemory:
         for d in self.people.values():
             if d.alive or d.upper is None or d.lower is None:
                 continue
-            dressed_like_her = min(
-                histogram_intersection(d.upper, target[0]),
-                histogram_intersection(d.lower, target[1]),
-            )
-            if dressed_like_her >= self.clothes_match:
+            if self.may_be_dressed_like(d, target):
                 continue
             s = min(histogram_intersection(upper, d.upper), histogram_intersection(lower, d.lower))
             if s >= s_target + self.link_margin:
                 return d
         return None
+
+    def may_be_dressed_like(self, d: Distractor, target: tuple[np.ndarray, np.ndarray]) -> bool:
+        """Whether distractor ``d`` may be dressed like ``target`` (upper and lower
+        histograms): their clothes match it at ``clothes_match``, or were never measured."""
+        if d.upper is None or d.lower is None:
+            return True
+        return (
+            min(
+                histogram_intersection(d.upper, target[0]),
+                histogram_intersection(d.lower, target[1]),
+            )
+            >= self.clothes_match
+        )
 
     def forget(self, track_id: int) -> None:
         """Drop a distractor (their face turned out to be hers after all)."""

@@ -26,9 +26,13 @@ see the face); while a look-alike is about, clothes are no evidence, so only a f
 and otherwise she is lost. A new track that takes her on where her named track was left (the
 camera first saw it there within a second and has not seen the old one since: the tracker lost
 her legs for a moment) is her, not a look-alike: the name follows her onto it after
-``SPLIT_FRAMES`` identifications at TARGET. The one exception is the start of a run, the
-**hand-off**: the one person tracked within ``handoff_range`` of the camera in the first
-``handoff_s``, in her clothes, is the person the robot was just shown and is named at once. A
+``SPLIT_FRAMES`` identifications at TARGET. So does a track that took her on from her named
+track — picked up anew there, swapped with it by a passer-by in other clothes, or one of the two
+after such a passer-by crossed her out of the camera's view — while every other person in her
+clothes seen so far is accounted for elsewhere: on such a track her clothes count though a
+look-alike is about (:meth:`TargetIdentifier._took_her_on`). The one exception is the start of
+a run, the **hand-off**: the one person tracked within ``handoff_range`` of the camera in the
+first ``handoff_s``, in her clothes, is the person the robot was just shown and is named at once. A
 look-alike is about while another track matches her clothes, and for ``look_alike_memory_s``
 after a person in her clothes was rejected by face, marked a distractor, or tracked at least
 ``coexist_distance`` from another person in her clothes at once (one of the two at most is her).
@@ -124,6 +128,13 @@ SPLIT_GAP_S = 1.0
 #: ... and is named in her place after this many identifications in a row at TARGET with the
 #: other unseen (not on one frame: two people seen in turns are not one picked up anew).
 SPLIT_FRAMES = 3
+#: After a passer-by in other clothes crossed her named track out of the camera's view (the
+#: name went, :meth:`TargetIdentifier._note_crossing`), the one of the two tracks that shows her
+#: clothes on this many fresh samples in a row within this long, s, took her on.
+CROSSED_S = 5.0
+#: A person in her clothes last seen this long ago may have walked this fast since, m/s
+#: (:meth:`TargetIdentifier._look_alikes_elsewhere`; the crowd's walkers reach 1.5 m/s).
+LOOK_ALIKE_SPEED = 1.5
 
 #: Numbers the identifiers, for their job keys.
 _IDENTIFIERS = itertools.count()
@@ -220,7 +231,8 @@ class _Evidence:
     """Known not to be her without a face: ``coexisted`` or ``linked`` (distractor memory)."""
     slid: bool = False
     """The track slid off a distractor's mark onto someone in her clothes
-    (:meth:`TargetIdentifier._check_slid_off_distractor`): only a face names it."""
+    (:meth:`TargetIdentifier._check_slid_off_distractor`): only a face names it, unless it took
+    her on from her named track (:meth:`TargetIdentifier._took_her_on`)."""
     streak: int = 0
     """Identifications in a row at TARGET (the confirmation of a switch without a face)."""
     last_match: float = -math.inf
@@ -232,6 +244,8 @@ class _Evidence:
     for ``doubt_s`` loses the name)."""
     unlike_since: float = math.inf
     """Since when the track's clothes have been clearly unlike hers (inf: they are not)."""
+    unlike_until: float = -math.inf
+    """The newest stamp at which the track's clothes were clearly unlike hers."""
     clear_clothes: list[float] = field(default_factory=list)
     """Relit clothes samples taken while no other person's box overlapped this one's (a person
     half hidden behind another shows partly the other's clothes)."""
@@ -371,6 +385,19 @@ class TargetIdentifier:
         self._look_alike_at = -math.inf
         """When a person in her clothes was last found not to be her (by face, or seen beside
         her, or linked to someone who was)."""
+        self._hers: set[int] = set()
+        """Every track ever named the target."""
+        self._dressed: dict[int, tuple[tuple[float, float], float]] = {}
+        """Every track whose clothes matched hers, where and when the camera last saw it so."""
+        self._held: dict[int, tuple[tuple[float, float], float]] = {}
+        """Where and when the tracker last detected each track (:meth:`note_tracks`)."""
+        self._dropped: tuple[_Evidence, float] | None = None
+        """The evidence of the track that last held the name when the name went on doubt or
+        the tracker deleted it, and when (:meth:`_took_her_on`)."""
+        self._crossed: tuple[float, dict[int, tuple[_Evidence, int]]] | None = None
+        """When a passer-by in other clothes last crossed her named track out of the camera's
+        view, and the two tracks, each with its number of clothes samples then
+        (:meth:`_after_crossing`)."""
         self._crowded: set[int] = set()
         """Tracks with another person within ``update_clearance`` (at the latest
         :meth:`note_tracks`)."""
@@ -549,7 +576,9 @@ class TargetIdentifier:
         person's: all are forgotten. Who the track follows now is not known: her, or a
         look-alike the coasting track met (traced, the crowd, seed 14: a walker's mark slid onto
         a look-alike, who was then named on her clothes). So her clothes are no evidence on it,
-        as while a look-alike is about: only a face names it, and it is someone to go and see."""
+        as while a look-alike is about: only a face names it, and it is someone to go and see —
+        unless it took her on from her named track with every look-alike accounted for
+        elsewhere (:meth:`_took_her_on`)."""
         p = self.params
         clothes = ev.clothes_now(p.clothes_recent)
         if clothes is None or clothes < p.clothes_similarity:
@@ -589,6 +618,13 @@ class TargetIdentifier:
             return True
         if self._named is not None and ev is self._tracks.get(self._named):
             return True  # hers: a slide onto someone else shows within a few frames
+        crossed = self._crossed
+        if (
+            crossed is not None
+            and t - crossed[0] <= CROSSED_S + STAMP_EPS
+            and any(ev is mine for mine, _ in crossed[1].values())
+        ):
+            return True  # one of the two who just crossed: her clothes show which is her
         if ev.face_distances:  # a face decides; clothes do not enter the decision
             return False
         clothes = ev.clothes_now(p.clothes_recent)
@@ -692,11 +728,16 @@ class TargetIdentifier:
             ev.distractor = None
         if ev.distractor is not None and clothes is not None and clothes >= p.clothes_similarity:
             self._look_alike_at = max(self._look_alike_at, now)  # someone else in her clothes
+        if clothes is not None and clothes >= p.clothes_similarity and ev.xy is not None:
+            self._dressed[track_id] = (ev.xy, ev.last_detected)
+        look_alike = (ev.slid or self._look_alike_about(track_id, now)) and not (
+            self._took_her_on(track_id, now)
+        )
         cues = Cues(
             face_distance=face_d,
             clothes_similarity=clothes,
             clothes_relit=relit,
-            look_alike_about=ev.slid or self._look_alike_about(track_id, now),
+            look_alike_about=look_alike,
             distractor=ev.distractor is not None,
             named=track_id == self._named,
         )
@@ -748,6 +789,7 @@ class TargetIdentifier:
         if not unlike:
             ev.unlike_since = math.inf
             return
+        ev.unlike_until = now
         if math.isfinite(ev.unlike_since):
             return
         ev.unlike_since = now
@@ -800,13 +842,23 @@ class TargetIdentifier:
         )
 
     def _name(self, t: float) -> None:
+        """Who is the target after this observation (:meth:`_choose`); every track ever named
+        is remembered as hers."""
+        self._choose(t)
+        if self._named is not None:
+            self._hers.add(self._named)
+
+    def _choose(self, t: float) -> None:
         """Who is the target after this observation (item 2): the named track while the tracker
-        holds it and it is not decided NOT_TARGET (continuity); else a track a face decides
-        TARGET at once; else a track decided TARGET on ``confirm_frames`` identifications in a
-        row over ``confirm_s`` (without a face that can only happen while no look-alike is
-        about: her clothes are no evidence then); else no one — she is lost, and the robot
-        searches."""
+        holds it and it is not decided NOT_TARGET (continuity); else the one track that took
+        her on from it (:meth:`_took_her_on`) and is decided TARGET :data:`SPLIT_FRAMES` times
+        in a row; else a track a face decides TARGET at once; else a track decided TARGET on
+        ``confirm_frames`` identifications in a row over ``confirm_s`` (without a face that can
+        only happen while no look-alike is about: her clothes are no evidence then); else no
+        one — she is lost, and the robot searches."""
         named = self._latest.get(self._named) if self._named is not None else None
+        if named is not None and self._doubted(named, t):
+            self._dropped = (self._tracks[named.track_id], t)
         if named is not None and not self._doubted(named, t):
             picked_up = self._picked_up(named.track_id, t)
             if picked_up is not None:
@@ -818,6 +870,18 @@ class TargetIdentifier:
                 self._learn_online(t)
                 return
             self._named = fresher
+            return
+        took = [
+            tid
+            for tid, ident in self._latest.items()
+            if tid != self._named
+            and ident.decision is Decision.TARGET
+            and self._tracks[tid].streak >= SPLIT_FRAMES
+            and abs(self._tracks[tid].last_detected - t) <= STAMP_EPS
+            and self._took_her_on(tid, t)
+        ]
+        if len(took) == 1:
+            self._named = took[0]
             return
         best: tuple[tuple[int, float, float], int] | None = None
         for tid, ident in self._latest.items():
@@ -834,6 +898,104 @@ class TargetIdentifier:
                 best = (key, tid)
         self._named = None if best is None else best[1]
         self._named_once |= self._named is not None
+
+    def _holder(self, now: float) -> _Evidence | None:
+        """The evidence of the track that holds her name, or held it until at most
+        :data:`SPLIT_GAP_S` ago (the name went on doubt, or the tracker deleted the track)."""
+        if self._named is not None and self._named in self._tracks:
+            return self._tracks[self._named]
+        if self._dropped is not None and now - self._dropped[1] <= SPLIT_GAP_S + STAMP_EPS:
+            return self._dropped[0]
+        return None
+
+    def _took_her_on(self, track_id: int, now: float) -> bool:
+        """Whether ``track_id`` took her on from the track that holds (or just held) her name —
+        picked up anew where that one was left (:meth:`_split`), or swapped with it as the two
+        passed (:meth:`_swapped`) — while every other person in her clothes seen so far is
+        accounted for elsewhere (:meth:`_look_alikes_elsewhere`). Such a track's clothes count
+        for her though a look-alike is about: the look-alikes are known to be elsewhere, and the
+        track holds her where her own track left her. Traced, the crowd, seed 7: her named
+        track coasted off her course, a new track took her on where it had been, in her clothes
+        (S 0.9), and stayed unknown because a look-alike, rejected 5 m away and tracked there,
+        was about; seed 3: a passer-by crossing her took her track (its clothes turned unlike
+        hers), and his own track took her on; she was lost both times, then searched for 50 s."""
+        new = self._tracks.get(track_id)
+        if new is None or new.xy is None:
+            return False
+        old = self._holder(now)
+        took = old is not None and (self._split(old, new) or self._swapped(old, new))
+        if old is not None and old is not new and took:
+            return self._look_alikes_elsewhere(track_id, new.xy, old, now)
+        return self._after_crossing(track_id, new, now)
+
+    def _after_crossing(self, track_id: int, new: _Evidence, now: float) -> bool:
+        """Whether ``track_id`` is one of the two tracks of a crossing that took the name away
+        (a passer-by in other clothes, her track out of the camera's view; at most
+        :data:`CROSSED_S` ago) and has shown her clothes on its newest :data:`SPLIT_FRAMES`
+        samples since, with every other person in her clothes accounted for elsewhere
+        (:meth:`_look_alikes_elsewhere`): after two people in different clothes crossed, the
+        one in hers is her. Traced, the crowd, seed 7: a passer-by stepped between the robot
+        and her, 0.2 m from her, and the name went; her track showed her clothes (S 0.9) right
+        after, and she stayed unknown until the search."""
+        if self._crossed is None or now - self._crossed[0] > CROSSED_S + STAMP_EPS:
+            return False
+        partners = self._crossed[1]
+        mine = partners.get(track_id)
+        if mine is None or mine[0] is not new:
+            return False
+        fresh = new.clothes[mine[1] :][-SPLIT_FRAMES:]
+        if len(fresh) < SPLIT_FRAMES or min(fresh) < self.params.clothes_similarity:
+            return False
+        other = next((ev for tid, (ev, _) in partners.items() if tid != track_id), new)
+        assert new.xy is not None
+        return self._look_alikes_elsewhere(track_id, new.xy, other, now)
+
+    def _swapped(self, old: _Evidence, new: _Evidence) -> bool:
+        """Whether the tracker swapped her track ``old`` with ``new`` as the two people passed:
+        ``old``'s clothes turned clearly unlike hers (it slid onto the other person) within
+        :data:`SPLIT_GAP_S` of when ``new``'s were last clearly unlike hers (it was the other
+        person), ``new``'s match hers now, and the camera saw the two within
+        ``coexist_distance`` of each other."""
+        p = self.params
+        if old.xy is None or new.xy is None or not math.isfinite(old.unlike_since):
+            return False
+        clothes = new.clothes_now(p.clothes_recent)
+        return (
+            clothes is not None
+            and clothes >= p.clothes_similarity
+            and abs(new.unlike_until - old.unlike_since) <= SPLIT_GAP_S
+            and math.dist(old.xy, new.xy) < p.coexist_distance
+        )
+
+    def _look_alikes_elsewhere(
+        self, track_id: int, xy: tuple[float, float], old: _Evidence, now: float
+    ) -> bool:
+        """Whether every other person in her clothes seen so far — a track whose clothes
+        matched hers (none ever named her, nor ``old``), or a remembered distractor dressed like
+        her or in clothes not known — was last seen (by the camera, or their track by the
+        laser) so far from ``xy`` and so lately that they cannot be there now:
+        ``coexist_distance`` plus :data:`LOOK_ALIKE_SPEED` m/s since."""
+        reach = self.params.coexist_distance
+
+        def could_be_here(tid: int, where: tuple[float, float], when: float) -> bool:
+            held = self._held.get(tid)
+            if held is not None and held[1] > when:
+                where, when = held
+            return math.dist(where, xy) < reach + LOOK_ALIKE_SPEED * max(0.0, now - when)
+
+        for tid, (where, when) in self._dressed.items():
+            if tid == track_id or tid in self._hers or self._tracks.get(tid) is old:
+                continue
+            if could_be_here(tid, where, when):
+                return False
+        target = (self.profile.upper, self.profile.lower)
+        return not any(
+            d.track_id != track_id
+            and d.track_id not in self._hers
+            and self.distractors.may_be_dressed_like(d, target)
+            and could_be_here(d.track_id, (d.x, d.y), d.t)
+            for d in self.distractors.people.values()
+        )
 
     def _hand_off(self, t: float, near: Collection[int]) -> None:
         """The start of following (item 2's one exception): within ``handoff_s`` of the first
@@ -863,6 +1025,7 @@ class TargetIdentifier:
         if any(k != track_id and self._may_be_her(k) for k in self._near_seen):
             return  # someone else near who may be her too (her clothes, or not seen yet)
         self._named, self._named_once = track_id, True
+        self._hers.add(track_id)
 
     def _handoff_open(self) -> bool:
         """Whether the hand-off may still name her: it is on, nobody was named yet, and no
@@ -978,9 +1141,10 @@ class TargetIdentifier:
         track at least ``coexist_distance`` from her is someone else (two places at once) and
         is marked so — a face match of its own is the only way back (item 1). Which tracks have
         another person within ``update_clearance`` is kept for the online appearance model
-        (item 5)."""
+        (item 5), and where each detected track is, for :meth:`_look_alikes_elsewhere`."""
         p = self.params
         xy = {tid: (x, y) for tid, x, y, _ in tracks}
+        self._held.update({tid: ((x, y), t) for tid, x, y, detected in tracks if detected})
         self._crowded = {
             a
             for a, (ax, ay) in xy.items()
@@ -990,7 +1154,7 @@ class TargetIdentifier:
             )
         }
         self._note_two_in_her_clothes(t, tracks)
-        self._note_crossing(xy)
+        self._note_crossing(t, xy)
         her = self._named
         ev = self._tracks.get(her) if her is not None else None
         if her is None or ev is None or her not in xy:
@@ -1010,7 +1174,7 @@ class TargetIdentifier:
             if other.distractor is not None:
                 self.distractors.remember(tid, (x, y), t, "coexisted", other.upper, other.lower)
 
-    def _note_crossing(self, xy: dict[int, tuple[float, float]]) -> None:
+    def _note_crossing(self, t: float, xy: dict[int, tuple[float, float]]) -> None:
         """Another person comes within ``swap_distance`` of her named track — someone tracked
         at least ``coexist_distance`` from it or seen by the camera beside it before, not a
         split of her own track — where the camera cannot tell the two apart: the other is in
@@ -1018,8 +1182,9 @@ class TargetIdentifier:
         people as they cross (traced: a look-alike crossing her, and her track coasting out of
         view onto a passer-by's legs), so which track is her is not known any more: the name
         goes (she is lost rather than someone else followed), and both tracks forget the faces
-        and the run of identifications they had (they may be the other person's). A face, or a
-        confirmed identification, names her again."""
+        and the run of identifications they had (they may be the other person's). A face, a
+        confirmed identification, or — when the other was in other clothes — her clothes on one
+        of the two afterwards (:meth:`_after_crossing`) names her again."""
         her = self._named
         if her != self._apart_of:
             self._apart, self._apart_of = set(), her
@@ -1040,10 +1205,16 @@ class TargetIdentifier:
                 continue
             other = self._tracks.get(tid)
             clothes = None if other is None else other.clothes_now(p.clothes_recent)
-            if unseen or (clothes is not None and clothes >= p.clothes_similarity):
+            dressed = clothes is not None and clothes >= p.clothes_similarity
+            if unseen or dressed:
                 self._named = None
                 for track_id in (her, tid):
                     self._forget_who(track_id)
+                if not dressed and ev is not None and other is not None:
+                    self._crossed = (
+                        t,
+                        {her: (ev, len(ev.clothes)), tid: (other, len(other.clothes))},
+                    )
                 return
 
     def _forget_who(self, track_id: int) -> None:
@@ -1149,11 +1320,13 @@ class TargetIdentifier:
 
     def forget(self, track_id: int) -> None:
         """Drop a track's evidence (the tracker deleted it); a distractor stays remembered."""
-        self._tracks.pop(track_id, None)
+        ev = self._tracks.pop(track_id, None)
         self._latest.pop(track_id, None)
         self.distractors.track_ended(track_id)
         if self._named == track_id:
             self._named = None
+            if ev is not None:
+                self._dropped = (ev, self._last_frame)
 
 
 __all__ = ["Decision", "FaceSearchStats", "TargetIdentifier", "TrackIdentity"]
