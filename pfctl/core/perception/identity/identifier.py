@@ -857,9 +857,10 @@ class TargetIdentifier:
         only happen while no look-alike is about: her clothes are no evidence then); else no
         one — she is lost, and the robot searches."""
         named = self._latest.get(self._named) if self._named is not None else None
-        if named is not None and self._doubted(named, t):
+        doubted = named is not None and self._doubted(named, t)
+        if named is not None and doubted:
             self._dropped = (self._tracks[named.track_id], t)
-        if named is not None and not self._doubted(named, t):
+        if named is not None and not doubted:
             picked_up = self._picked_up(named.track_id, t)
             if picked_up is not None:
                 self._named = picked_up
@@ -918,7 +919,8 @@ class TargetIdentifier:
         track coasted off her course, a new track took her on where it had been, in her clothes
         (S 0.9), and stayed unknown because a look-alike, rejected 5 m away and tracked there,
         was about; seed 3: a passer-by crossing her took her track (its clothes turned unlike
-        hers), and his own track took her on; she was lost both times, then searched for 50 s."""
+        hers), and his own track took her on. She was lost both times, and not re-found in the
+        minute."""
         new = self._tracks.get(track_id)
         if new is None or new.xy is None:
             return False
