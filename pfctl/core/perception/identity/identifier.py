@@ -911,8 +911,9 @@ class TargetIdentifier:
 
     def _took_her_on(self, track_id: int, now: float) -> bool:
         """Whether ``track_id`` took her on from the track that holds (or just held) her name —
-        picked up anew where that one was left (:meth:`_split`), or swapped with it as the two
-        passed (:meth:`_swapped`) — while every other person in her clothes seen so far is
+        picked up anew where that one was left (:meth:`_split`), swapped with it as the two
+        passed (:meth:`_swapped`), or the one in her clothes of the two tracks of a crossing
+        (:meth:`_after_crossing`) — while every other person in her clothes seen so far is
         accounted for elsewhere (:meth:`_look_alikes_elsewhere`). Such a track's clothes count
         for her though a look-alike is about: the look-alikes are known to be elsewhere, and the
         track holds her where her own track left her. Traced, the crowd, seed 7: her named
