@@ -932,7 +932,7 @@ def test_her_track_picked_up_anew_takes_the_name_while_the_look_alikes_are_elsew
 def test_a_passer_by_swapped_with_her_hands_her_name_to_his_track(learned) -> None:
     """The crowd, seed 3: a passer-by in other clothes crossed her; the tracker swapped the
     two tracks, so her named track turned to his clothes (the name went) and his track to
-    hers, with a look-alike tracked 4.5 m away. She was lost and searched for 50 s. Now the
+    hers, with a look-alike tracked 4.5 m away. She was lost, not re-found in the minute. Now the
     track that took her on from hers is named once its clothes say hers three times in a row;
     with the look-alike unaccounted for (not seen for 3 s, 2 m off), it is not."""
     profile, params, encoder = learned
