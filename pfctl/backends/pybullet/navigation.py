@@ -16,14 +16,20 @@ what the laser no longer sees). It re-plans when obstacle points (laser returns 
 part of the static map) lie on the path ahead, or when the robot makes no progress for
 :data:`STUCK_TIME` seconds, marking those points as obstacles; after :data:`MAX_REPLANS` re-plans
 without success the goal is ABORTED. Like move_base's costmap, which clears what the laser no
-longer shows, a marked point is forgotten :data:`BLOCKER_MEMORY`
-seconds after the laser last showed something there; while the path goes round marked points it
-is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken when it is
-:data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment does not send
-the robot round the house. A goal that lies inside the marks (a person stands on or beside the
-place to look from) is planned to the nearest point free of them within
-:data:`MARKED_GOAL_TOLERANCE`, as navfn's ``default_tolerance`` does for move_base, and the robot
-arrives there: the end of its path. Pure numpy: no pybullet.
+longer shows, a marked point is forgotten once a beam of a scan passes beyond it with no return
+near it (:meth:`Navigator.clear_seen`: the costmap's ray-trace clearing; a person who walked on
+leaves no trail of marks behind), and in any case :data:`BLOCKER_MEMORY` seconds after the
+laser last showed something there (a mark out of the laser's view); while the path goes round
+marked points it is planned again every :data:`RECONSIDER_PERIOD` seconds and the new path taken
+when it is :data:`RECONSIDER_GAIN` metres shorter — a person who stood in a door for a moment
+does not send the robot round the house. Nor does a person crossing the path ahead: when the
+way round the points that block it is more than :data:`DETOUR_EXTRA` metres longer than the path
+through them (round a table, through another room), the robot first stands and waits up to
+:data:`DETOUR_WAIT_S` seconds for them to pass (Nav2's *Wait* recovery; people walk on), and
+takes the way round only if the path is still blocked. A goal that lies inside the marks (a
+person stands on or beside the place to look from) is planned to the nearest point free of them
+within :data:`MARKED_GOAL_TOLERANCE`, as navfn's ``default_tolerance`` does for move_base, and
+the robot arrives there: the end of its path. Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -35,7 +41,7 @@ from scipy import optimize
 from scipy.spatial import cKDTree
 
 from pfctl.core.mapping.planning import GridPlanner, NoPathError
-from pfctl.core.robot import STOP, NavStatus, Pose2D, Twist2D
+from pfctl.core.robot import STOP, LaserScan, NavStatus, Pose2D, Twist2D
 
 #: Pure-pursuit carrot distance along the path, metres.
 LOOKAHEAD = 0.5
@@ -64,6 +70,10 @@ BLOCKER_MEMORY = 4.0
 RECONSIDER_PERIOD = 2.0
 #: … and the new path is taken when it is at least this much shorter than the rest (m).
 RECONSIDER_GAIN = 1.0
+#: A way round blocking points this much longer (m) than the path through them ...
+DETOUR_EXTRA = 2.0
+#: ... is taken only after the path has stayed blocked this long (s), the robot waiting.
+DETOUR_WAIT_S = 3.0
 #: A goal inside the marked points is planned to the nearest point free of them within this,
 #: metres (navfn's ``default_tolerance``); farther, the re-plan fails as before.
 MARKED_GOAL_TOLERANCE = 0.6
@@ -107,6 +117,8 @@ class Navigator:
         self._best = math.inf
         self._since_progress = 0.0
         self._wait = 0.0
+        self._waited = 0.0
+        """Seconds stood waiting for a blocked path to clear before a long way round."""
         self._blockers = np.empty((0, 2))
         """Obstacle points marked by re-plans (map frame), planned round until forgotten."""
         self._blocker_seen = np.empty(0)
@@ -129,6 +141,12 @@ class Navigator:
     @property
     def status(self) -> NavStatus:
         return self._status
+
+    @property
+    def marks(self) -> np.ndarray:
+        """The obstacle points marked by re-plans and not forgotten yet, ``(n, 2)`` (map
+        frame)."""
+        return self._blockers.copy()
 
     def accept(self, goal: Pose2D) -> None:
         """Take a new goal without planning yet (a running one is PREEMPTED), as move_base
@@ -204,18 +222,48 @@ class Navigator:
         keep = self._clock - self._blocker_seen <= BLOCKER_MEMORY
         self._blockers, self._blocker_seen = self._blockers[keep], self._blocker_seen[keep]
 
+    def clear_seen(self, scan: LaserScan) -> None:
+        """Forget the marks ``scan`` sees free: a beam toward the mark returns from farther
+        than BLOCKER_RADIUS beyond it (or not at all), and no return lies within BLOCKER_RADIUS
+        of it (move_base's costmap ray-trace clearing; ``scan.pose`` in the map frame of the
+        marks)."""
+        if not len(self._blockers):
+            return
+        o = scan.pose
+        rel = self._blockers - np.array([o.x, o.y])
+        dist = np.hypot(rel[:, 0], rel[:, 1])
+        bearing = (np.arctan2(rel[:, 1], rel[:, 0]) - o.theta + np.pi) % (2 * np.pi) - np.pi
+        beam = np.rint((bearing - scan.angle_min) / scan.angle_increment).astype(int)
+        inside = (beam >= 0) & (beam < len(scan.ranges)) & (dist < scan.range_max)
+        ranges = np.asarray(scan.ranges, dtype=float)
+        reach = np.where(np.isfinite(ranges), ranges, scan.range_max)
+        beyond = np.zeros(len(dist), dtype=bool)
+        beyond[inside] = reach[beam[inside]] > dist[inside] + BLOCKER_RADIUS
+        if not beyond.any():
+            return
+        points = scan.points()
+        if len(points):
+            near, _ = cKDTree(points).query(self._blockers[beyond], k=1)
+            beyond[np.flatnonzero(beyond)[near <= BLOCKER_RADIUS]] = False
+        self._blockers, self._blocker_seen = self._blockers[~beyond], self._blocker_seen[~beyond]
+
     def _planner_now(self) -> GridPlanner:
         """The static map with the marked points as discs of BLOCKER_RADIUS."""
         if not len(self._blockers):
             return self.planner
         return self.planner.with_obstacles(self._blockers, BLOCKER_RADIUS)
 
-    def _plan_round_marks(self, pose: Pose2D) -> np.ndarray:
-        """A path from ``pose`` on :meth:`_planner_now`'s map: to the goal, or, when the goal is
-        inside the marks, to the nearest point free of them within MARKED_GOAL_TOLERANCE.
-        Raises :class:`NoPathError` as :meth:`GridPlanner.plan` does."""
+    def _plan_round_marks(self, pose: Pose2D, extra: np.ndarray | None = None) -> np.ndarray:
+        """A path from ``pose`` on :meth:`_planner_now`'s map (with the points ``extra`` marked
+        too): to the goal, or, when the goal is inside the marks, to the nearest point free of
+        them within MARKED_GOAL_TOLERANCE. Raises :class:`NoPathError` as
+        :meth:`GridPlanner.plan` does."""
         assert self.goal is not None
-        planner = self._planner_now()
+        if extra is not None and len(extra):
+            marks = np.vstack([self._blockers, extra])
+            planner = self.planner.with_obstacles(marks, BLOCKER_RADIUS)
+        else:
+            planner = self._planner_now()
         goal = np.array([self.goal.x, self.goal.y])
         if planner is not self.planner and not planner.is_free(goal):
             near = planner.nearest_free(goal, MARKED_GOAL_TOLERANCE)
@@ -248,6 +296,26 @@ class Navigator:
         self._best = math.inf
         self._since_progress = 0.0
         self._wait = 0.0
+        self._waited = 0.0
+
+    def _wait_for(self, pose: Pose2D, blockers: np.ndarray, rest: float, dt: float) -> bool:
+        """Whether to stand and wait for ``blockers`` to leave the path (``rest`` m to go)
+        rather than plan round them now: while the path has been blocked for less than
+        DETOUR_WAIT_S in all since the last progress, and the way round them (and the marks) is
+        more than DETOUR_EXTRA longer, or there is none."""
+        if self._waited >= DETOUR_WAIT_S:
+            return False
+        if self._waited == 0.0:
+            try:
+                way = self._plan_round_marks(pose, blockers)
+                longer = float(np.linalg.norm(np.diff(way, axis=0), axis=1).sum()) - rest
+            except NoPathError:
+                longer = math.inf
+            if longer <= DETOUR_EXTRA:
+                self._waited = DETOUR_WAIT_S  # a short way round: take it now
+                return False
+        self._waited += dt
+        return True
 
     # ----------------------------------------------------------------------------------------
 
@@ -404,11 +472,14 @@ class Navigator:
         if rest < self._best - PROGRESS:
             self._best = rest
             self._since_progress = 0.0
+            self._waited = 0.0
         else:
             self._since_progress += dt
         blockers = self._blocked(self._ahead(i, proj, CHECK_AHEAD), dynamic)
         if len(blockers) and self._since_replan < REPLAN_PERIOD:
             return STOP  # just re-planned and still blocked: wait for the next re-plan
+        if len(blockers) and self._wait_for(pose, blockers, rest, dt):
+            return STOP
         if len(blockers) or self._since_progress > STUCK_TIME:
             if not len(blockers) and len(dynamic):
                 blockers = dynamic[np.linalg.norm(dynamic - xy, axis=1) < 1.0]

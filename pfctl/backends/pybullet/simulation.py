@@ -382,6 +382,7 @@ class SimRobot:
                 synced = True
             scan = self.laser.scan(self.pose, self._legs(), self.time)
             self._scan_points = scan.points()  # MOVE_BASE's view, with the true pose
+            self.navigator.clear_seen(scan)
             believed = self.laser_spec.laser_pose(self.localized_pose)
             if len(self._scans) == self._scans.maxlen:
                 self.dropped_scans += 1

@@ -9,6 +9,7 @@ import pytest
 import shapely
 
 from pfctl.backends.pybullet.navigation import (
+    DETOUR_WAIT_S,
     MARKED_GOAL_TOLERANCE,
     PERSON_MARGIN,
     RECENT_PEOPLE_S,
@@ -18,7 +19,7 @@ from pfctl.backends.pybullet.navigation import (
 )
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import wall_footprint
-from pfctl.core.robot import NavStatus, Pose2D, Twist2D
+from pfctl.core.robot import LaserScan, NavStatus, Pose2D, Twist2D
 from pfctl.mission import Mission
 
 pytestmark = pytest.mark.sim
@@ -247,3 +248,94 @@ def test_a_person_seen_a_moment_ago_behind_the_robot_is_still_kept_clear_of(
     xy = np.array([(p.x, p.y) for p in poses])
     assert xy[-1, 0] < 3.9  # it did set off
     assert np.linalg.norm(xy[:, None] - leg[None], axis=2).min() >= reach - 0.03
+
+
+def _ring(center: tuple[float, float], radius: float = 0.2) -> np.ndarray:
+    angles = np.linspace(0, 2 * np.pi, 24)
+    return np.asarray(center) + radius * np.column_stack((np.cos(angles), np.sin(angles)))
+
+
+def test_a_person_crossing_the_door_ahead_is_waited_for_not_gone_round(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """Traced, the shipped house (randomized, seed 46): people walking through the kitchen's
+    door to the hall sent the robot round the dining table toward the living room each time
+    and back when they had passed, for 50 s. A person in the door for 2 s: the way round her
+    (through the living room) is far longer than the path through the door, so the robot stands
+    and waits for her to pass instead of planning round her."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 3.3), Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office
+    person = _ring((2.3, 4.0))
+    clock = {"t": 0.0}
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        clock["t"] += DT
+        return person if clock["t"] <= 2.0 else np.empty((0, 2))
+
+    nav.start(goal, start)
+    poses, cmds = _drive(nav, start, 200.0, seen)
+    assert nav.status is NavStatus.SUCCEEDED
+    assert nav.total_replans == 0  # never planned round her
+    assert any(c == Twist2D() for c in cmds[:20])  # it stood while she was in the door
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert not np.any(xy[:, 0] > 5.0)
+    assert xy[:, 1].min() > start.y - 0.1  # never back toward the living room's door
+    through_door = (np.abs(xy[:, 1] - 4.0) < 0.15) & (xy[:, 0] > 1.9) & (xy[:, 0] < 2.7)
+    assert through_door.any()
+
+
+def test_a_short_way_round_a_person_is_taken_without_waiting(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """A person stands in the 2 m wide hall: the way round her is a little longer than the
+    path through her (less than DETOUR_EXTRA), so the robot goes round at once."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 5.0), Pose2D(8.0, 5.0)
+    person = _ring((3.0, 5.0))
+    nav.start(goal, start)
+    _, cmds = _drive(nav, start, 120.0, lambda pose: person)
+    assert nav.status is NavStatus.SUCCEEDED
+    assert nav.total_replans >= 1
+    still = longest = 0
+    for c in cmds:
+        still = still + 1 if c == Twist2D() else 0
+        longest = max(longest, still)
+    assert longest * DT < DETOUR_WAIT_S
+
+
+def _scan(pose: Pose2D, ranges: np.ndarray) -> LaserScan:
+    return LaserScan(0.0, -3 * math.pi / 4, math.radians(0.5), 0.05, 10.0, ranges, pose)
+
+
+def test_marks_the_laser_sees_through_are_forgotten(planner: GridPlanner) -> None:
+    """A person blocked the hall and was marked. A scan whose beams pass beyond the marks, with
+    no return near them, clears them (move_base's ray-trace clearing); a return at the marks (she
+    is still there) or before them (something hides them) keeps them."""
+    pose = Pose2D(1.0, 5.0, 0.0)
+    beams = 541
+    legs = np.array([[2.0, 5.1], [2.0, 4.9]])
+
+    def marked() -> Navigator:
+        nav = Navigator(planner, 0.22, 0.8)
+        nav.start(Pose2D(8.0, 5.0), pose)
+        nav.update(pose, DT, legs)
+        assert len(nav.marks) == 2
+        return nav
+
+    nav = marked()
+    nav.clear_seen(_scan(pose, np.full(beams, np.inf)))  # nothing there now
+    assert len(nav.marks) == 0
+
+    nav = marked()
+    nav.clear_seen(_scan(pose, np.full(beams, 0.6)))  # something nearer hides the spot
+    assert len(nav.marks) == 2
+
+    nav = marked()
+    angles = -3 * math.pi / 4 + math.radians(0.5) * np.arange(beams)
+    ranges = np.full(beams, np.inf)
+    for leg in legs:  # her legs still return the beams toward them
+        bearing = math.atan2(leg[1] - pose.y, leg[0] - pose.x)
+        k = int(np.argmin(np.abs(angles - bearing)))
+        ranges[k - 2 : k + 3] = math.dist(leg, (pose.x, pose.y)) - 0.03
+    nav.clear_seen(_scan(pose, ranges))
+    assert len(nav.marks) == 2
