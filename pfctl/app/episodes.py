@@ -25,7 +25,7 @@ from pfctl.app.perception import build_perception, identity_params
 from pfctl.app.profiles import check_target_profile, load_target_profile
 from pfctl.app.spill import spill_log
 from pfctl.core.episode import EpisodeLog, TickRecord
-from pfctl.core.mapping.grid import FREE
+from pfctl.core.mapping.grid import FREE, OCCUPIED
 from pfctl.core.metrics import MetricParams, search_metrics
 from pfctl.core.perception.face_worker import FaceWorker
 from pfctl.core.perception.identity.params import FaceTiming
@@ -170,6 +170,7 @@ def run_episode(
         detector=detector,
         profile=profile,
         belief_grid=(grid.geometry, grid.states() != FREE),
+        occupied=(grid.geometry, grid.states() == OCCUPIED),
         face_worker=use_worker,
         face_timing=face_timing,
         robot=kind,

@@ -11,6 +11,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Literal
 
+import numpy as np
 from numpy.typing import ArrayLike
 
 from pfctl.app.leg_models import load_leg_model
@@ -75,6 +76,7 @@ def build_perception(
     detector: PersonDetector | None = None,
     profile: TargetProfile | None = None,
     belief_grid: tuple[GridGeometry, ArrayLike] | None = None,
+    occupied: tuple[GridGeometry, ArrayLike] | None = None,
     leg_model: Path | None = None,
     face_worker: bool | FaceWorker = False,
     face_timing: FaceTiming | None = None,
@@ -84,7 +86,8 @@ def build_perception(
     """The mission's perception: its leg model (``leg_model`` overrides
     ``perception.legs.model``; neither: the shipped model), tracker, and — when given — a
     camera ``detector``, a target ``profile`` to identify, and a human belief over
-    ``belief_grid`` = (geometry, blocked mask).
+    ``belief_grid`` = (geometry, blocked mask); ``occupied`` = (geometry, the static map's
+    occupied cells), where no leg counts (:class:`~pfctl.core.perception.pipeline.Perception`).
 
     ``face_worker``: True starts a :class:`~pfctl.core.perception.face_worker.FaceWorker` for the
     identifier's face searches (only with a ``profile`` that has faces), or pass one; False
@@ -124,6 +127,7 @@ def build_perception(
         identifier=identifier,
         belief=belief,
         camera_range=(camera.range_min, camera.range_max),
+        occupied=None if occupied is None else (occupied[0], np.asarray(occupied[1], dtype=bool)),
     )
 
 

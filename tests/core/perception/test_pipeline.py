@@ -12,6 +12,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from pfctl.core.mapping.grid import GridGeometry
 from pfctl.core.perception.legs.detector import (
     LegDetections,
     LegDetector,
@@ -220,3 +221,29 @@ def test_with_the_static_scene_filter_a_person_standing_still_keeps_her_track() 
     (track,) = perception.tracks()
     assert track.status is TrackStatus.CONFIRMED and track.last_seen == pytest.approx(2.925)
     assert math.dist(track.position, HER) < 0.1
+
+
+def test_no_leg_counts_inside_an_occupied_cell_of_the_static_map() -> None:
+    """Both segments make single-leg candidates (thresholds lowered to the forest's score);
+    with the static map's occupied cells given, the one inside a wall — a door jamb's end face,
+    as traced in the shipped house — is dropped, legs and candidate, and starts no track."""
+    params = LegParams(history_scans=1, probability=0.3, single_leg_probability=0.3)
+    geometry = GridGeometry(0.05, 160, 160, (-4.0, -4.0))
+    occupied = np.zeros(geometry.shape, dtype=bool)
+    rows, cols = geometry.world_to_cell(TABLE_LEG)
+    occupied[rows - 2 : rows + 3, cols - 2 : cols + 3] = True  # a 0.25 m wall end there
+
+    def tracked(walls: tuple[GridGeometry, np.ndarray] | None) -> list[tuple[float, float]]:
+        legs = LegDetector(FixedScore(), params)  # type: ignore[arg-type]
+        perception = Perception(legs, MultiPersonTracker(), occupied=walls)
+        for k in range(10):
+            found = perception.on_scan(_scan(0.1 * k))
+        if walls is not None:
+            assert all(math.dist((c.x, c.y), TABLE_LEG) > 0.3 for c in found.people)
+            assert all(math.dist((g.x, g.y), TABLE_LEG) > 0.3 for g in found.legs)
+        return sorted(
+            (round(t.x, 1), round(t.y, 1)) for t in perception.tracks(confirmed_only=False)
+        )
+
+    assert tracked(None) == [(2.5, -2.0), (3.0, 0.0)]  # no map: the wall's "leg" is someone
+    assert tracked((geometry, occupied)) == [(3.0, 0.0)]
