@@ -26,10 +26,12 @@ does not send the robot round the house. Nor does a person crossing the path ahe
 way round the points that block it is more than :data:`DETOUR_EXTRA` metres longer than the path
 through them (round a table, through another room), the robot first stands and waits up to
 :data:`DETOUR_WAIT_S` seconds for them to pass (Nav2's *Wait* recovery; people walk on), and
-takes the way round only if the path is still blocked. A goal that lies inside the marks (a
-person stands on or beside the place to look from) is planned to the nearest point free of them
-within :data:`MARKED_GOAL_TOLERANCE`, as navfn's ``default_tolerance`` does for move_base, and
-the robot arrives there: the end of its path. Pure numpy: no pybullet.
+takes the way round only if the path is still blocked — those seconds counted over goals, so
+that following her (a new goal every few of her steps) never waits longer. A goal that lies
+inside the marks (a person stands on or beside the place to look from) is planned to the
+nearest point free of them within :data:`MARKED_GOAL_TOLERANCE`, as navfn's
+``default_tolerance`` does for move_base, and the robot arrives there: the end of its path.
+Pure numpy: no pybullet.
 """
 
 from __future__ import annotations
@@ -74,6 +76,9 @@ RECONSIDER_GAIN = 1.0
 DETOUR_EXTRA = 2.0
 #: ... is taken only after the path has stayed blocked this long (s), the robot waiting.
 DETOUR_WAIT_S = 3.0
+#: A blockage is over once the path ahead has been clear this long (s): the next one may be
+#: waited on again.
+BLOCKAGE_OVER_S = 1.0
 #: A goal inside the marked points is planned to the nearest point free of them within this,
 #: metres (navfn's ``default_tolerance``); farther, the re-plan fails as before.
 MARKED_GOAL_TOLERANCE = 0.6
@@ -118,7 +123,11 @@ class Navigator:
         self._since_progress = 0.0
         self._wait = 0.0
         self._waited = 0.0
-        """Seconds stood waiting for a blocked path to clear before a long way round."""
+        """Seconds stood waiting for the path to clear before a long way round, since it was
+        last clear for BLOCKAGE_OVER_S (over goals: following her, MOVE_BASE gets a new goal
+        every few steps she takes)."""
+        self._clear_for = 0.0
+        """Seconds since sensed points last blocked the path ahead."""
         self._blockers = np.empty((0, 2))
         """Obstacle points marked by re-plans (map frame), planned round until forgotten."""
         self._blocker_seen = np.empty(0)
@@ -296,13 +305,13 @@ class Navigator:
         self._best = math.inf
         self._since_progress = 0.0
         self._wait = 0.0
-        self._waited = 0.0
 
     def _wait_for(self, pose: Pose2D, blockers: np.ndarray, rest: float, dt: float) -> bool:
         """Whether to stand and wait for ``blockers`` to leave the path (``rest`` m to go)
-        rather than plan round them now: while the path has been blocked for less than
-        DETOUR_WAIT_S in all since the last progress, and the way round them (and the marks) is
-        more than DETOUR_EXTRA longer, or there is none."""
+        rather than plan round them now: while the robot has stood less than DETOUR_WAIT_S in
+        all for this blockage (the path not clear for BLOCKAGE_OVER_S since, whatever the goals),
+        and the way round them (and the marks) is more than DETOUR_EXTRA longer, or there is
+        none."""
         if self._waited >= DETOUR_WAIT_S:
             return False
         if self._waited == 0.0:
@@ -472,10 +481,12 @@ class Navigator:
         if rest < self._best - PROGRESS:
             self._best = rest
             self._since_progress = 0.0
-            self._waited = 0.0
         else:
             self._since_progress += dt
         blockers = self._blocked(self._ahead(i, proj, CHECK_AHEAD), dynamic)
+        self._clear_for = 0.0 if len(blockers) else self._clear_for + dt
+        if self._clear_for >= BLOCKAGE_OVER_S:
+            self._waited = 0.0
         if len(blockers) and self._since_replan < REPLAN_PERIOD:
             return STOP  # just re-planned and still blocked: wait for the next re-plan
         if len(blockers) and self._wait_for(pose, blockers, rest, dt):

@@ -339,3 +339,24 @@ def test_marks_the_laser_sees_through_are_forgotten(planner: GridPlanner) -> Non
         ranges[k - 2 : k + 3] = math.dist(leg, (pose.x, pose.y)) - 0.03
     nav.clear_seen(_scan(pose, ranges))
     assert len(nav.marks) == 2
+
+
+def test_waiting_for_a_person_is_bounded_over_goals_sent_while_following(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """Following her, MOVE_BASE gets a new goal every few of her steps. A person who stays in
+    the kitchen's door is waited on for DETOUR_WAIT_S in all, not afresh for every goal (the
+    robot would stand there while she walks away), and then gone round."""
+    nav = _navigator(mission, planner)
+    pose = Pose2D(1.0, 3.3)
+    person = _ring((2.3, 4.0))
+    stood = 0.0
+    for k in range(100):  # 10 s
+        if k % 5 == 0:  # her next steps: a new goal every 0.5 s, 0.4 m farther on
+            nav.start(Pose2D(3.0 + 0.04 * k, 7.5, math.pi / 2), pose)
+        cmd = nav.update(pose, DT, person)
+        stood += DT if cmd == Twist2D() else 0.0
+        pose = _move(pose, cmd, DT)
+    assert nav.status is NavStatus.ACTIVE
+    assert DETOUR_WAIT_S - DT <= stood <= DETOUR_WAIT_S + 1.5  # + the re-plans' own pauses
+    assert math.dist((pose.x, pose.y), (1.0, 3.3)) > 1.0  # on its way round her
