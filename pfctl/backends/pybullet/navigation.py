@@ -128,6 +128,9 @@ class Navigator:
         every few steps she takes)."""
         self._clear_for = 0.0
         """Seconds since sensed points last blocked the path ahead."""
+        self._waiting = False
+        """The way round this blockage was weighed and found long: stand (up to
+        DETOUR_WAIT_S) without weighing it again."""
         self._blockers = np.empty((0, 2))
         """Obstacle points marked by re-plans (map frame), planned round until forgotten."""
         self._blocker_seen = np.empty(0)
@@ -314,15 +317,15 @@ class Navigator:
         none."""
         if self._waited >= DETOUR_WAIT_S:
             return False
-        if self._waited == 0.0:
+        if not self._waiting:
             try:
                 way = self._plan_round_marks(pose, blockers)
                 longer = float(np.linalg.norm(np.diff(way, axis=0), axis=1).sum()) - rest
             except NoPathError:
                 longer = math.inf
             if longer <= DETOUR_EXTRA:
-                self._waited = DETOUR_WAIT_S  # a short way round: take it now
-                return False
+                return False  # a short way round: take it now (the next blocking is weighed anew)
+        self._waiting = True
         self._waited += dt
         return True
 
@@ -486,7 +489,7 @@ class Navigator:
         blockers = self._blocked(self._ahead(i, proj, CHECK_AHEAD), dynamic)
         self._clear_for = 0.0 if len(blockers) else self._clear_for + dt
         if self._clear_for >= BLOCKAGE_OVER_S:
-            self._waited = 0.0
+            self._waited, self._waiting = 0.0, False
         if len(blockers) and self._since_replan < REPLAN_PERIOD:
             return STOP  # just re-planned and still blocked: wait for the next re-plan
         if len(blockers) and self._wait_for(pose, blockers, rest, dt):

@@ -360,3 +360,30 @@ def test_waiting_for_a_person_is_bounded_over_goals_sent_while_following(
     assert nav.status is NavStatus.ACTIVE
     assert DETOUR_WAIT_S - DT <= stood <= DETOUR_WAIT_S + 1.5  # + the re-plans' own pauses
     assert math.dist((pose.x, pose.y), (1.0, 3.3)) > 1.0  # on its way round her
+
+
+def test_a_short_way_round_taken_does_not_spend_the_wait_for_a_long_one(
+    mission: Mission, planner: GridPlanner
+) -> None:
+    """Traced, the shipped house (randomized, seed 40, on `08c2de1`): a person in the kitchen
+    was gone round by a short way (5.7 -> 4.9 m); a second later another in the kitchen's door
+    blocked that path, and the way round through the living room (15.4 m) was taken at once,
+    with no wait: the short way had marked the blockage as waited on. Each blocking is weighed
+    anew until the robot has stood for one."""
+    nav = _navigator(mission, planner)
+    start, goal = Pose2D(1.0, 3.3), Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office
+    first, second = _ring((1.5, 3.1), 0.1), _ring((2.3, 4.0))
+    clock = {"t": 0.0}
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        clock["t"] += DT
+        if clock["t"] <= 1.0:
+            return first  # a short way round him
+        return second if clock["t"] <= 3.5 else np.empty((0, 2))  # then her in the door
+
+    nav.start(goal, start)
+    poses, _ = _drive(nav, start, 200.0, seen)
+    assert nav.status is NavStatus.SUCCEEDED
+    xy = np.array([(p.x, p.y) for p in poses])
+    assert not np.any(xy[:, 0] > 5.0)  # never toward the living room
+    assert xy[:, 1].min() > 2.9  # nor round the dining table
