@@ -17,9 +17,8 @@ between the scans taken before and after it):
   field of view with its returns as occluders). With the static map's occupied cells given
   (``occupied``), the legs and candidates inside them are dropped first: nobody stands inside a
   wall or a piece of furniture, and what the forest takes for a leg there is the map's own
-  clutter (traced, the shipped house: the end faces of door jambs, 4.6 % of a randomized
-  episode's candidates, made a coasting target track jump 0.8 m onto the office door's jamb
-  and started a phantom person in the living room's corner);
+  clutter (the end faces of door jambs, a wall's corner), which would pull a coasting track onto
+  it or start a person who is not there;
 - an **RGB-D frame** → a :class:`~pfctl.core.perception.vision.PersonDetector` → 3-D people →
   the same tracker (``camera`` detections, the camera's floor wedge) → Algorithm 2
   (:class:`~pfctl.core.perception.identity.identifier.TargetIdentifier`, one call per frame) for
