@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 import pytest
@@ -52,6 +53,23 @@ def _drive(nav: Navigator, pose: Pose2D, seconds: float, obstacles=None):
         if nav.status is not NavStatus.ACTIVE:
             break
     return poses, cmds
+
+
+def _ring(center: tuple[float, float], radius: float = 0.2) -> np.ndarray:
+    """A person's outline as the laser sees it: 24 points round ``center``."""
+    angles = np.linspace(0, 2 * np.pi, 24)
+    return np.asarray(center) + radius * np.column_stack((np.cos(angles), np.sin(angles)))
+
+
+def _seen_for(points: np.ndarray, seconds: float) -> Callable[[Pose2D], np.ndarray]:
+    """Obstacle points the laser shows for the first ``seconds`` of a drive, then nothing."""
+    clock = {"t": 0.0}
+
+    def seen(pose: Pose2D) -> np.ndarray:
+        clock["t"] += DT
+        return points if clock["t"] <= seconds else np.empty((0, 2))
+
+    return seen
 
 
 def test_reaches_a_goal_in_another_room_within_limits(
@@ -118,18 +136,8 @@ def test_a_door_blocked_for_a_moment_is_taken_once_clear(
     no longer shows her there, and goes through that door after all: not round the house."""
     nav = _navigator(mission, planner)
     start, goal = Pose2D(1.0, 3.3), Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office
-    person = np.array([2.3, 4.0])
-    ring = person + 0.2 * np.column_stack(
-        (np.cos(np.linspace(0, 2 * np.pi, 24)), np.sin(np.linspace(0, 2 * np.pi, 24)))
-    )
-    clock = {"t": 0.0}
-
-    def seen(pose: Pose2D) -> np.ndarray:
-        clock["t"] += DT
-        return ring if clock["t"] <= 4.0 else np.empty((0, 2))
-
     nav.start(goal, start)
-    poses, _ = _drive(nav, start, 200.0, seen)
+    poses, _ = _drive(nav, start, 200.0, _seen_for(_ring((2.3, 4.0)), 4.0))
     assert nav.status is NavStatus.SUCCEEDED
     assert nav.total_replans >= 1  # it did plan round her
     xy = np.array([(p.x, p.y) for p in poses])
@@ -250,11 +258,6 @@ def test_a_person_seen_a_moment_ago_behind_the_robot_is_still_kept_clear_of(
     assert np.linalg.norm(xy[:, None] - leg[None], axis=2).min() >= reach - 0.03
 
 
-def _ring(center: tuple[float, float], radius: float = 0.2) -> np.ndarray:
-    angles = np.linspace(0, 2 * np.pi, 24)
-    return np.asarray(center) + radius * np.column_stack((np.cos(angles), np.sin(angles)))
-
-
 def test_a_person_crossing_the_door_ahead_is_waited_for_not_gone_round(
     mission: Mission, planner: GridPlanner
 ) -> None:
@@ -265,15 +268,8 @@ def test_a_person_crossing_the_door_ahead_is_waited_for_not_gone_round(
     and waits for her to pass instead of planning round her."""
     nav = _navigator(mission, planner)
     start, goal = Pose2D(1.0, 3.3), Pose2D(3.0, 7.5, math.pi / 2)  # kitchen -> office
-    person = _ring((2.3, 4.0))
-    clock = {"t": 0.0}
-
-    def seen(pose: Pose2D) -> np.ndarray:
-        clock["t"] += DT
-        return person if clock["t"] <= 2.0 else np.empty((0, 2))
-
     nav.start(goal, start)
-    poses, cmds = _drive(nav, start, 200.0, seen)
+    poses, cmds = _drive(nav, start, 200.0, _seen_for(_ring((2.3, 4.0)), 2.0))
     assert nav.status is NavStatus.SUCCEEDED
     assert nav.total_replans == 0  # never planned round her
     assert any(c == Twist2D() for c in cmds[:20])  # it stood while she was in the door
