@@ -391,6 +391,10 @@ class TargetIdentifier:
         """Every track whose clothes matched hers, where and when the camera last saw it so."""
         self._held: dict[int, tuple[tuple[float, float], float]] = {}
         """Where and when the tracker last detected each track (:meth:`note_tracks`)."""
+        self._her_at: tuple[tuple[float, float], float] | None = None
+        """Where and when the tracker last detected the named track (:meth:`_note_out_of_reach`)."""
+        self._astray: set[int] = set()
+        """Tracks detected where she cannot have been (:meth:`_note_out_of_reach`)."""
         self._dropped: tuple[_Evidence, float] | None = None
         """The evidence of the track that last held the name when the name went on doubt or
         the tracker deleted it, and when (:meth:`_took_her_on`)."""
@@ -892,7 +896,7 @@ class TargetIdentifier:
                 ident.face_distance is not None and ident.face_distance < self.params.face_distance
             )
             ev = self._tracks[tid]
-            if not face and not self._confirmed(ev, t):
+            if not face and (not self._confirmed(ev, t) or tid in self._astray):
                 continue
             key = (int(face), ident.log_odds, ident.last_seen)
             if best is None or key > best[0]:
@@ -1157,6 +1161,7 @@ class TargetIdentifier:
             )
         }
         self._note_two_in_her_clothes(t, tracks)
+        self._note_out_of_reach(t, tracks)
         self._note_crossing(t, xy)
         her = self._named
         ev = self._tracks.get(her) if her is not None else None
@@ -1220,6 +1225,29 @@ class TargetIdentifier:
                     )
                 return
 
+    def _note_out_of_reach(
+        self, t: float, tracks: Sequence[tuple[int, float, float, bool]]
+    ) -> None:
+        """Where she can be (issue 23, item 1: track continuity and where she can have walked):
+        the named track's latest detected place is remembered, and every other track detected
+        farther from it than she can have walked since — ``coexist_distance`` plus
+        :data:`LOOK_ALIKE_SPEED` m/s — is someone else, and is not named on clothes alone
+        (:meth:`_choose`) nor gone to see (:meth:`candidate_track`). Traced, the crowd, seed 27:
+        3.1 s after her track was lost, a track in her clothes 8.2 m from where it was lost was
+        confirmed on clothes alone, and followed. Before anyone is named nothing is known of where
+        she is, and after a long loss she can be anywhere: the mark then never happens."""
+        her = self._named
+        for tid, x, y, detected in tracks:
+            if tid == her and detected:
+                self._her_at = ((x, y), t)
+        if self._her_at is None:
+            return
+        (hx, hy), when = self._her_at
+        reach = self.params.coexist_distance + LOOK_ALIKE_SPEED * max(0.0, t - when)
+        for tid, x, y, detected in tracks:
+            if tid != her and detected and math.hypot(x - hx, y - hy) > reach:
+                self._astray.add(tid)
+
     def _forget_who(self, track_id: int) -> None:
         """Forget what said who a track is: its faces and its run of identifications (the
         tracker may have swapped it onto someone else, :meth:`_note_crossing`)."""
@@ -1229,6 +1257,7 @@ class TargetIdentifier:
         ev.face_distances.clear()
         ev.last_match = ev.last_face = -math.inf
         ev.streak, ev.streak_since = 0, math.inf
+        self._astray.discard(track_id)
         if track_id in self._latest:
             self._latest[track_id] = self._decide(track_id, ev, None)
 
@@ -1305,6 +1334,7 @@ class TargetIdentifier:
                 and (ident.legs_seen or self._dressed_as_her(ident))
                 and not ev.face_distances
                 and ev.distractor is None
+                and tid not in self._astray
                 and ident.clothes_relit is not None
                 and ident.clothes_relit >= p.clothes_similarity
                 and (best is None or ident.last_seen > best[0])
@@ -1325,6 +1355,7 @@ class TargetIdentifier:
         """Drop a track's evidence (the tracker deleted it); a distractor stays remembered."""
         ev = self._tracks.pop(track_id, None)
         self._latest.pop(track_id, None)
+        self._astray.discard(track_id)
         self.distractors.track_ended(track_id)
         if self._named == track_id:
             self._named = None

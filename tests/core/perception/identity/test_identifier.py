@@ -462,6 +462,38 @@ def test_without_a_face_a_new_track_is_named_only_after_confirm_frames_in_a_row(
     assert named == [None] * 4 + [1] * 4
 
 
+def test_a_track_where_she_cannot_have_walked_since_her_loss_is_not_named_on_her_clothes() -> None:
+    """No faces, no look-alike seen at once: track 1, named on her clothes at the origin, is
+    deleted at 2 s. A track in her clothes first detected 1 s later 8 m away (she walks at most
+    ``coexist_distance`` + 1.5 m/s since) is someone else: never named, nor a candidate to go
+    and see, however long it shows her clothes. The same track first detected 2 m away is
+    named once confirmed."""
+    params = IdentityParams(faces=False, confirm_frames=5, confirm_s=1.0)
+    img, det = _shirt((80, 150), (RED,))
+    profile = learn_profile([describe(img, det, params)], params)
+    for x, named_after in ((8.0, None), (2.0, 2)):
+        ident = TargetIdentifier(profile, params)
+        for k in range(20):
+            t = 0.1 * k
+            ident.note_tracks(t, [(1, 0.0, 0.0, True)])
+            ident.observe(1, t, True, replace(det, position=(0.0, 0.0, 1.0)), img)
+        assert ident.target_track() == 1
+        ident.forget(1)
+        named, candidates = [], []
+        for k in range(30, 100):
+            t = 0.1 * k
+            ident.note_tracks(t, [(2, x, 0.0, True)])
+            seen = ident.observe(2, t, True, replace(det, position=(x, 0.0, 1.0)), img)
+            assert seen.decision is Decision.TARGET
+            named.append(ident.target_track())
+            candidates.append(ident.candidate_track())
+        assert named[-1] == named_after, x
+        if named_after is None:
+            assert set(named) == {None} and set(candidates) == {None}
+        else:
+            assert named[:10] == [None] * 10 and candidates[0] == 2
+
+
 def test_a_person_rejected_by_face_stays_rejected_when_their_track_is_made_again(learned) -> None:
     """A look-alike's face rejects track 2; the tracker loses it and makes track 3 where it
     was a second later, seen from behind in her clothes: still not her, never named. A face of
