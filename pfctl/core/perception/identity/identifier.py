@@ -384,7 +384,7 @@ class TargetIdentifier:
         """The named track ``_apart`` is about."""
         self._look_alike_at = -math.inf
         """When a person in her clothes was last found not to be her (by face, or seen beside
-        her, or linked to someone who was)."""
+        her or where she cannot have been, or linked to someone who was)."""
         self._hers: set[int] = set()
         """Every track ever named the target."""
         self._dressed: dict[int, tuple[tuple[float, float], float]] = {}
@@ -732,6 +732,8 @@ class TargetIdentifier:
             ev.distractor = None
         if ev.distractor is not None and clothes is not None and clothes >= p.clothes_similarity:
             self._look_alike_at = max(self._look_alike_at, now)  # someone else in her clothes
+        elif track_id in self._astray and self._dressed_now(ev):
+            self._look_alike_at = max(self._look_alike_at, now)  # in her clothes where she is not
         if clothes is not None and clothes >= p.clothes_similarity and ev.xy is not None:
             self._dressed[track_id] = (ev.xy, ev.last_detected)
         look_alike = (ev.slid or self._look_alike_about(track_id, now)) and not (
@@ -800,6 +802,18 @@ class TargetIdentifier:
         if math.isfinite(ev.last_match):
             ev.face_distances.clear()
             ev.last_match = ev.last_face = -math.inf
+
+    def _dressed_now(self, ev: _Evidence) -> bool:
+        """Whether a track shows her clothes now: its median and its newest sample match hers
+        (a track that coasted onto a passer-by keeps her clothes in its median for a few
+        frames, :meth:`_note_two_in_her_clothes`)."""
+        p = self.params
+        clothes = ev.clothes_now(p.clothes_recent)
+        return (
+            clothes is not None
+            and clothes >= p.clothes_similarity
+            and ev.clothes[-1] >= p.clothes_similarity
+        )
 
     def _rejected_by_face(
         self, track_id: int, ev: _Evidence, clothes: float | None, now: float
@@ -1232,7 +1246,8 @@ class TargetIdentifier:
         the named track's latest detected place is remembered, and every other track detected
         farther from it than she can have walked since — ``coexist_distance`` plus
         :data:`LOOK_ALIKE_SPEED` m/s — is someone else, and is not named on clothes alone
-        (:meth:`_choose`) nor gone to see (:meth:`candidate_track`). Traced, the crowd, seed 27:
+        (:meth:`_choose`) nor gone to see (:meth:`candidate_track`); shown in her clothes
+        there, a look-alike is about (:meth:`_decide`). Traced, the crowd, seed 27:
         3.1 s after her track was lost, a track in her clothes 8.2 m from where it was lost was
         confirmed on clothes alone, and followed. Before anyone is named nothing is known of where
         she is, and after a long loss she can be anywhere: the mark then never happens."""
@@ -1282,13 +1297,7 @@ class TargetIdentifier:
             ev = self._tracks.get(tid)
             if ev is None:
                 continue
-            clothes = ev.clothes_now(p.clothes_recent)
-            if (
-                clothes is not None
-                and clothes >= p.clothes_similarity
-                and ev.clothes[-1] >= p.clothes_similarity
-                and t - ev.last_clothes <= FRESH_CLOTHES_S + STAMP_EPS
-            ):
+            if self._dressed_now(ev) and t - ev.last_clothes <= FRESH_CLOTHES_S + STAMP_EPS:
                 dressed.append((ev, x, y))
         if any(
             math.hypot(ax - bx, ay - by) >= p.coexist_distance

@@ -132,8 +132,9 @@ class IdentityParams:
     )
     look_alike_memory_s: float = param(
         120.0,
-        "After a person in her clothes was found not to be her (by face, or seen beside her,"
-        " or two people in her clothes were tracked apart at once), her clothes are no evidence"
+        "After a person in her clothes was found not to be her (by face, or seen beside her or"
+        " farther off than she can have walked since she was last tracked, or two people in her"
+        " clothes were tracked apart at once), her clothes are no evidence"
         " for this long (a look-alike is about).",
         unit="s",
         ge=0,
