@@ -13,8 +13,12 @@ progress (``PROGRESS`` m) for ``AFTER_S`` seconds with a person within ``NEAR`` 
 ``STEP`` m out of that person's way — to the side first, off the line from them through the
 robot (the way they want to go, as far as the robot can tell), else back — along a straight line
 that is free on the static map, and holds there until ``FOR_S`` seconds have passed since its
-last step; then it drives on to its goal. When the person comes on its way there (traced, seed
-14: its diagonal step back was where he was going), it steps aside again, a few times at most.
+last step; then it drives on to its goal. When a person stands in its way there (traced, seed
+14: its diagonal step back was where he was going, and he waited), it steps aside again, a few
+times at most; a person walking past it there, as the one it gave way to does, does not make it
+step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off, and
+its second and third steps took it 2 m back down the hall, 24 s from giving way to being where it
+gave way again).
 The robot's MOVE_BASE keeps its own recovery (re-plan, abort); giving way adds the one thing it
 cannot do, moving off the goal's path.
 """
@@ -22,6 +26,7 @@ cannot do, moving off the goal's path.
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -55,11 +60,13 @@ class GiveWay:
     CLEAR = 0.8
     #: Giving way (the step and the wait there) lasts this long, s, from the last step.
     FOR_S = 5.0
-    #: The robot is at its place this close to it, m; a person still within ``CLEAR`` m this
+    #: The robot is at its place this close to it, m; a person standing within ``CLEAR`` m this
     #: long after a step gets another, up to ``STEPS`` in a row.
     ARRIVED = 0.15
     SETTLE_S = 1.0
     STEPS = 3
+    #: A person who moved less than this, m, over the last ``SETTLE_S`` is standing.
+    STILL = 0.3
     #: A go-to not asked for this long, s, starts the progress clock afresh.
     GAP_S = 0.5
 
@@ -69,21 +76,27 @@ class GiveWay:
         self._progress: tuple[float, XY] | None = None
         """When and where the robot last made progress toward a goal."""
         self._asked_at = -math.inf
+        self._seen: deque[tuple[float, np.ndarray]] = deque()
+        """The people's positions at each call of the last ``2 · SETTLE_S`` (:meth:`_standing`)."""
 
     def check(self, now: float, here: XY, people: ArrayLike, planner: GridPlanner) -> XY | None:
         """The place to give way at this tick (None: drive on to the goal): called on every
         tick the robot drives to a goal, at time ``now`` and position ``here``, with the
-        other people's positions ``(n, 2)`` and the static map's ``planner``. A person still
-        within ``CLEAR`` m once the robot stands at its place (they came on its way) gets a
-        step aside from there too, up to ``STEPS`` in all."""
+        other people's positions ``(n, 2)`` and the static map's ``planner``. A person standing
+        within ``CLEAR`` m once the robot stands at its place (they came on its way, and wait)
+        gets a step aside from there too, up to ``STEPS`` in all."""
         gap = now - self._asked_at > self.GAP_S
         self._asked_at = now
         pts = np.asarray(people, dtype=float).reshape(-1, 2)
+        self._seen.append((now, pts))
+        while self._seen[0][0] < now - 2 * self.SETTLE_S:
+            self._seen.popleft()
         y = self.yielding
         if y is not None and not gap and now - y.since < self.FOR_S:
             there = math.dist(here, y.to) <= self.ARRIVED
             if there and y.steps < self.STEPS and now - y.since >= self.SETTLE_S:
-                again = self._step(now, here, pts, planner, self.CLEAR, y.steps + 1)
+                standing = pts[[self._standing(now, p) for p in pts]]
+                again = self._step(now, here, pts, planner, self.CLEAR, y.steps + 1, standing)
                 if again is not None:
                     return again
             return y.to
@@ -99,21 +112,40 @@ class GiveWay:
         return self._step(now, here, pts, planner, self.NEAR, 1)
 
     def _step(
-        self, now: float, here: XY, people: np.ndarray, planner: GridPlanner, near: float, n: int
+        self,
+        now: float,
+        here: XY,
+        people: np.ndarray,
+        planner: GridPlanner,
+        near: float,
+        n: int,
+        whom: np.ndarray | None = None,
     ) -> XY | None:
-        """Give way to the nearest person within ``near`` m (the ``n``-th step): the place."""
-        if len(people) == 0:
+        """Give way to the nearest person within ``near`` m (the ``n``-th step) of ``whom``
+        (default: everyone in ``people``): the place, clear of all ``people``."""
+        whom = people if whom is None else whom
+        if len(whom) == 0:
             return None
-        d = np.hypot(people[:, 0] - here[0], people[:, 1] - here[1])
+        d = np.hypot(whom[:, 0] - here[0], whom[:, 1] - here[1])
         k = int(np.argmin(d))
         if d[k] > near:
             return None
-        person = (float(people[k, 0]), float(people[k, 1]))
+        person = (float(whom[k, 0]), float(whom[k, 1]))
         to = self.place(here, person, people, planner)
         if to is None:
             return None
         self.yielding = Yielding(now, to, n)
         return to
+
+    def _standing(self, now: float, person: np.ndarray) -> bool:
+        """Whether ``person`` stands: someone was within ``STILL`` m of the place at the newest
+        call at least ``SETTLE_S`` ago (a person walking has moved on from it). Without such a
+        call, or with nobody seen then, not known: standing, as before this was asked."""
+        past = [pts for t, pts in self._seen if t <= now - self.SETTLE_S + 1e-9]
+        if not past or len(past[-1]) == 0:
+            return True
+        then = past[-1]
+        return float(np.min(np.hypot(then[:, 0] - person[0], then[:, 1] - person[1]))) < self.STILL
 
     def place(self, here: XY, person: XY, people: np.ndarray, planner: GridPlanner) -> XY | None:
         """Where to step out of ``person``'s way: ``STEP`` m from ``here`` to either side, then

@@ -97,6 +97,27 @@ def test_a_person_coming_its_way_gets_another_step_aside(intents: Intents) -> No
     assert math.dist(y.to, toward) >= GiveWay.CLEAR
 
 
+def test_a_person_walking_past_the_place_it_stepped_to_gets_no_other_step(
+    intents: Intents,
+) -> None:
+    """The house, seed 7: the person it gave way to walks round the robot at its place, 0.6 m
+    off; the robot holds there and drives on, without a second step back down the hall. Had
+    he stood there, he would have had one (the test above)."""
+    t = _stuck(intents, [WAITING], until=2 * GiveWay.AFTER_S)
+    assert isinstance(intents.base, Navigate)
+    first = (intents.base.goal.x, intents.base.goal.y)
+    since = t
+    for k in range(1, round(GiveWay.FOR_S / 0.1) + 3):
+        t = since + 0.1 * k
+        walker = (first[0] - 1.5 + 0.05 * k, first[1] + 0.6)  # 0.5 m/s, past the robot
+        _go(intents, t, first, [walker])
+        y = intents.give_way.yielding
+        if y is None:
+            break
+        assert y.steps == 1, t
+    assert intents.base_mode == "move_base" and intents.give_way.yielding is None
+
+
 def test_no_step_aside_with_nobody_near_or_while_the_robot_moves(intents: Intents) -> None:
     _stuck(intents, [(8.0, 2.0)], until=2 * GiveWay.AFTER_S)  # the nearest: across the house
     assert intents.base_mode == "move_base" and intents.give_way.yielding is None
