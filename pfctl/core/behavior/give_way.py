@@ -95,7 +95,7 @@ class GiveWay:
         if y is not None and not gap and now - y.since < self.FOR_S:
             there = math.dist(here, y.to) <= self.ARRIVED
             if there and y.steps < self.STEPS and now - y.since >= self.SETTLE_S:
-                standing = pts[[self._standing(now, p) for p in pts]]
+                standing = pts[self._standing(now, pts)]
                 again = self._step(now, here, pts, planner, self.CLEAR, y.steps + 1, standing)
                 if again is not None:
                     return again
@@ -137,15 +137,17 @@ class GiveWay:
         self.yielding = Yielding(now, to, n)
         return to
 
-    def _standing(self, now: float, person: np.ndarray) -> bool:
-        """Whether ``person`` stands: someone was within ``STILL`` m of the place at the newest
-        call at least ``SETTLE_S`` ago (a person walking has moved on from it). Without such a
-        call, or with nobody seen then, not known: standing, as before this was asked."""
+    def _standing(self, now: float, people: np.ndarray) -> np.ndarray:
+        """Which of ``people`` ``(n, 2)`` stand (a boolean mask): someone was within ``STILL`` m
+        of each one's place at the newest call at least ``SETTLE_S`` ago (a person walking has
+        moved on from it). Without such a call, or with nobody seen then, not known: standing,
+        as before this was asked."""
         past = [pts for t, pts in self._seen if t <= now - self.SETTLE_S + 1e-9]
         if not past or len(past[-1]) == 0:
-            return True
+            return np.ones(len(people), dtype=bool)
         then = past[-1]
-        return float(np.min(np.hypot(then[:, 0] - person[0], then[:, 1] - person[1]))) < self.STILL
+        d = np.hypot(people[:, None, 0] - then[None, :, 0], people[:, None, 1] - then[None, :, 1])
+        return d.min(axis=1) < self.STILL
 
     def place(self, here: XY, person: XY, people: np.ndarray, planner: GridPlanner) -> XY | None:
         """Where to step out of ``person``'s way: ``STEP`` m from ``here`` to either side, then
