@@ -8,7 +8,9 @@ before a stop); at each intermediate stop the person pauses for about ``pause_s`
 stop a person stays there, or walks back to the first stop and starts again when ``loop``. A
 person whose way the robot stands in waits, and after :data:`STEP_ROUND_AFTER` seconds steps round
 it when there is room (a path no more than :data:`STEP_ROUND_DETOUR` metres longer), as people
-do: nobody stands in a hall for a minute waiting for a robot to move.
+do: nobody stands in a hall for a minute waiting for a robot to move. A person whose next stop
+the robot stands on (within the distance they keep from it) stops short of it, as if there, and
+goes on with the route.
 
 The two legs are what a laser sees (the paper detects people by their legs, §II-E): cylinders of
 :data:`LEG_RADIUS` beside the body centre, swinging forward and back in opposite phase with a
@@ -44,6 +46,8 @@ MIN_SPEED, MAX_SPEED = 0.3, 1.4
 STEP_ROUND_AFTER = 2.0
 #: … and takes one at most this much longer (m) than the rest of the way it was walking.
 STEP_ROUND_DETOUR = 4.0
+#: A person this near (m) the next stop is there, though the robot keep them from the last step.
+AT_STOP = 0.1
 #: The first word of the seeds of ``scenario.randomize``'s random streams.
 RANDOMIZE = 7919
 
@@ -188,6 +192,9 @@ class Walker:
             ox, oy, clear = keep_clear
             after = math.hypot(pos[0] - ox, pos[1] - oy)
             if after < clear and after < math.hypot(self.x - ox, self.y - oy):
+                if remaining <= AT_STOP:
+                    self._arrive()  # traced: a person stood 1.5 cm from a stop for good
+                    return
                 self.speed = 0.0
                 self._settle_legs(dt)
                 self._waited += dt
@@ -210,9 +217,14 @@ class Walker:
         """Walk the rest of this leg round the obstacle at ``(ox, oy)``: re-plan from here to the
         leg's end with it a disc that keeps ``clear`` metres from its centre, and take the path
         if it is at most STEP_ROUND_DETOUR longer. Where there is no room (the robot in a
-        door, or at the leg's end) the person waits on. The route's own legs are unchanged, so a
-        looping person walks them again next time."""
+        door) the person waits on; where the leg's end itself is that near the robot, the person
+        stops here instead, as people do when the place they were going is taken. The route's own
+        legs are unchanged, so a looping person walks them again next time."""
         rest = float(self._cum[-1]) - self._s
+        end = self._path[-1]
+        if math.hypot(end[0] - ox, end[1] - oy) < clear:
+            self._arrive()
+            return
         disc = clear - self._planner.robot_radius + 0.05
         try:
             path = self._planner.with_obstacles([(ox, oy)], disc).plan(

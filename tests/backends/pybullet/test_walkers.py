@@ -165,3 +165,32 @@ def test_a_person_steps_round_a_robot_standing_in_the_hall_but_waits_in_a_door(
     door = _walk_past_a_robot(planner, (1.5, 3.2), (2.5, 5.0), (2.3, 4.0), 30.0)
     assert np.linalg.norm(door - (2.3, 4.0), axis=1).min() >= CLEAR - 0.05
     assert np.linalg.norm(door[-1] - (2.5, 5.0)) > 1.0  # never got through
+
+
+@pytest.mark.parametrize("robot_x", [4.4, 4.5])
+def test_a_person_whose_stop_the_robot_stands_on_stops_short_and_walks_on(
+    planner: GridPlanner, robot_x: float
+) -> None:
+    """A person walks along the hall to a stop at (4, 5) and back; a robot stands just past the
+    stop, so the stop itself is within the distance the person keeps from it. The person stops
+    short of it (at once when a few centimetres short, else after waiting STEP_ROUND_AFTER), and
+    walks back, never within the courtesy distance (traced, the house, seed 46: a person stood
+    1.5 cm from their stop, by the robot, until the robot gave way)."""
+    walker = Walker(
+        "p",
+        [np.array((1.0, 5.0)), np.array((4.0, 5.0)), np.array((1.0, 5.0))],
+        planner.with_radius(PERSON_RADIUS),
+        speed=0.8,
+        clothes=Clothes((0, 0, 0), (0, 0, 0)),
+        pause_s=1.0,
+    )
+    track = []
+    for _ in range(int(30.0 / DT)):
+        walker.step(DT, keep_clear=(robot_x, 5.0, CLEAR))
+        track.append((walker.x, walker.y))
+        if walker.done:
+            break
+    track_xy = np.array(track)
+    assert walker.done
+    assert np.linalg.norm(track_xy[-1] - (1.0, 5.0)) < 1e-6
+    assert np.linalg.norm(track_xy - (robot_x, 5.0), axis=1).min() >= CLEAR - 0.05
