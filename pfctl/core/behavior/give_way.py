@@ -18,7 +18,11 @@ last step; then it drives on to its goal. When a person stands in its way there 
 times at most; a person walking past it there, as the one it gave way to does, does not make it
 step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off, and
 its second and third steps took it 2 m back down the hall, 24 s from giving way to being where it
-gave way again).
+gave way again). A person waiting in a door of the robot's room may be going to any other door
+of it, so the step keeps off those ways too (traced, the house, seed 40: a person coming into the
+kitchen from the hall, on her way to the living room's door, waited in the hall's door; the
+robot's step to the side was onto her way, and she walked behind it, 0.6 m off, as it stepped
+twice more, 13 s in all).
 The robot's MOVE_BASE keeps its own recovery (re-plan, abort); giving way adds the one thing it
 cannot do, moving off the goal's path.
 """
@@ -27,14 +31,17 @@ from __future__ import annotations
 
 import math
 from collections import deque
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from pfctl.core.mapping.planning import GridPlanner
+from pfctl.core.mapping.regions import RegionMap
 
 XY = tuple[float, float]
+Segment = tuple[XY, XY]
 
 
 @dataclass(frozen=True)
@@ -69,6 +76,8 @@ class GiveWay:
     STILL = 0.3
     #: A go-to not asked for this long, s, starts the progress clock afresh.
     GAP_S = 0.5
+    #: A person this near (m) a door of the robot's room is coming through it.
+    AT_DOOR = 1.0
 
     def __init__(self) -> None:
         self.yielding: Yielding | None = None
@@ -79,10 +88,18 @@ class GiveWay:
         self._seen: deque[tuple[float, np.ndarray]] = deque()
         """The people's positions at each call of the last ``2 · SETTLE_S`` (:meth:`_standing`)."""
 
-    def check(self, now: float, here: XY, people: ArrayLike, planner: GridPlanner) -> XY | None:
+    def check(
+        self,
+        now: float,
+        here: XY,
+        people: ArrayLike,
+        planner: GridPlanner,
+        regions: RegionMap | None = None,
+    ) -> XY | None:
         """The place to give way at this tick (None: drive on to the goal): called on every
         tick the robot drives to a goal, at time ``now`` and position ``here``, with the
-        other people's positions ``(n, 2)`` and the static map's ``planner``. A person standing
+        other people's positions ``(n, 2)``, the static map's ``planner`` and the house's
+        ``regions`` (their doors: :meth:`ways`; None: not known). A person standing
         within ``CLEAR`` m once the robot stands at its place (they came on its way, and wait)
         gets a step aside from there too, up to ``STEPS`` in all."""
         gap = now - self._asked_at > self.GAP_S
@@ -96,7 +113,9 @@ class GiveWay:
             there = math.dist(here, y.to) <= self.ARRIVED
             if there and y.steps < self.STEPS and now - y.since >= self.SETTLE_S:
                 standing = pts[self._standing(now, pts)]
-                again = self._step(now, here, pts, planner, self.CLEAR, y.steps + 1, standing)
+                again = self._step(
+                    now, here, pts, planner, regions, self.CLEAR, y.steps + 1, standing
+                )
                 if again is not None:
                     return again
             return y.to
@@ -109,7 +128,7 @@ class GiveWay:
             self._progress = p = (now, here)
         if now - p[0] < self.AFTER_S:
             return None
-        return self._step(now, here, pts, planner, self.NEAR, 1)
+        return self._step(now, here, pts, planner, regions, self.NEAR, 1)
 
     def _step(
         self,
@@ -117,6 +136,7 @@ class GiveWay:
         here: XY,
         people: np.ndarray,
         planner: GridPlanner,
+        regions: RegionMap | None,
         near: float,
         n: int,
         whom: np.ndarray | None = None,
@@ -131,7 +151,8 @@ class GiveWay:
         if d[k] > near:
             return None
         person = (float(whom[k, 0]), float(whom[k, 1]))
-        to = self.place(here, person, people, planner)
+        ways = () if regions is None else self.ways(here, person, regions)
+        to = self.place(here, person, people, planner, ways)
         if to is None:
             return None
         self.yielding = Yielding(now, to, n)
@@ -149,11 +170,35 @@ class GiveWay:
         d = np.hypot(people[:, None, 0] - then[None, :, 0], people[:, None, 1] - then[None, :, 1])
         return d.min(axis=1) < self.STILL
 
-    def place(self, here: XY, person: XY, people: np.ndarray, planner: GridPlanner) -> XY | None:
+    def ways(self, here: XY, person: XY, regions: RegionMap) -> list[Segment]:
+        """Where ``person`` may be going through the robot's room: from the door of the room
+        they stand at (within ``AT_DOOR`` m) to each other door of it; none when they stand at
+        no door, or the robot is in no region."""
+        room = regions.locate(here)
+        if room is None:
+            return []
+        doors = regions.door_midpoints(room)
+        if len(doors) < 2:
+            return []
+        d = [math.dist(person, m) for m in doors]
+        k = int(np.argmin(d))
+        if d[k] > self.AT_DOOR:
+            return []
+        return [(doors[k], m) for i, m in enumerate(doors) if i != k]
+
+    def place(
+        self,
+        here: XY,
+        person: XY,
+        people: np.ndarray,
+        planner: GridPlanner,
+        ways: Sequence[Segment] = (),
+    ) -> XY | None:
         """Where to step out of ``person``'s way: ``STEP`` m from ``here`` to either side, then
         diagonally back, then straight back (away from them), the first place farthest from
-        the line from them through the robot, reached in a straight line free on the static
-        map, and ``CLEAR`` m from everyone; None when there is no such place."""
+        the line from them through the robot and from their other ``ways`` (:meth:`ways`),
+        reached in a straight line free on the static map, and ``CLEAR`` m from everyone; None
+        when there is no such place."""
         u = np.array([here[0] - person[0], here[1] - person[1]])
         norm = float(np.linalg.norm(u))
         u = u / norm if norm > 1e-9 else np.array([1.0, 0.0])
@@ -167,6 +212,8 @@ class GiveWay:
             if np.min(np.hypot(people[:, 0] - to[0], people[:, 1] - to[1])) < self.CLEAR:
                 continue
             off_line = abs(float(np.dot(to - np.asarray(person), n)))
+            for a, b in ways:
+                off_line = min(off_line, _distance_to_segment(to, a, b))
             if best is None or off_line > best[0] + 1e-6:
                 best = (off_line, (float(to[0]), float(to[1])))
         return None if best is None else best[1]
@@ -182,3 +229,10 @@ class GiveWay:
         """The goal was reached or given up: the next goal starts the clock afresh."""
         self.yielding = None
         self._progress = None
+
+
+def _distance_to_segment(p: np.ndarray, a: XY, b: XY) -> float:
+    """Distance from point ``p`` to the segment ``a``–``b``, m."""
+    pa, ab = np.asarray(p) - np.asarray(a), np.subtract(b, a)
+    t = float(np.clip(np.dot(pa, ab) / max(float(np.dot(ab, ab)), 1e-12), 0.0, 1.0))
+    return float(np.linalg.norm(pa - t * ab))

@@ -175,6 +175,11 @@ class RegionMap:
             return ()
         return tuple(self.graph.edges[a, b]["doors"])
 
+    def door_midpoints(self, name: str) -> list[XY]:
+        """The midpoint of every door of region ``name``, in the order of :meth:`neighbours`
+        (KeyError if unknown)."""
+        return [_midpoint(d) for n in self.neighbours(name) for d in self.doors_between(name, n)]
+
     def blocked_mask(self, geometry: GridGeometry) -> NDArray[np.bool_]:
         """Cells of a grid with ``geometry`` that the region map alone says nobody can be in or
         pass through: outside every region (more than a cell away), or on a region boundary that

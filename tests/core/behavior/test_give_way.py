@@ -125,3 +125,37 @@ def test_no_step_aside_with_nobody_near_or_while_the_robot_moves(intents: Intent
         xy = (DOOR[0] - 0.01 * k, DOOR[1] + 0.01 * k)  # slowly, but on its way
         _go(intents, 100.0 + 0.1 * k, xy, [(xy[0], xy[1] + 0.6)])
         assert intents.base_mode == "move_base"
+
+
+def test_a_person_in_a_door_of_its_room_gets_a_step_off_the_ways_to_its_other_doors(
+    planner: GridPlanner, layout: HouseLayout
+) -> None:
+    """The house's seed 40: the robot, just inside the kitchen's door to the hall, on its way
+    out; a person waits in that door, coming in. Her way may be to the kitchen's other door
+    (the living room's): the robot's step keeps off the line from the door she is in to that
+    one, as well as off the line from her through it (before, it stepped onto that way: 0.15 m
+    from it, and she walked behind it as it stepped twice more)."""
+    regions = RegionMap(layout)
+    here, person = (2.21, 3.72), (2.46, 4.22)
+    give_way = GiveWay()
+    t, aside = 0.0, None
+    while aside is None and t <= 2 * GiveWay.AFTER_S:
+        aside = give_way.check(t, here, [person], planner, regions)
+        t += 0.1
+    assert aside is not None
+    assert math.dist(aside, here) == pytest.approx(GiveWay.STEP)
+    doors = regions.door_midpoints("kitchen")
+    (hall_door,) = [d for d in doors if math.dist(d, person) <= GiveWay.AT_DOOR]
+    for other in doors:
+        if other != hall_door:
+            assert _to_segment(aside, hall_door, other) >= 0.5
+    assert give_way.ways(here, (3.0, 1.0), regions) == []  # in the room, at no door
+    assert GiveWay().place(here, person, np.array([person]), planner) == pytest.approx(
+        (3.10, 3.27), abs=0.02
+    )  # without the doors: onto her way to the living room
+
+
+def _to_segment(p: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
+    ab, ap = np.subtract(b, a), np.subtract(p, a)
+    t = float(np.clip(np.dot(ap, ab) / np.dot(ab, ab), 0.0, 1.0))
+    return float(np.linalg.norm(ap - t * ab))
