@@ -55,7 +55,7 @@ from pfctl.backends.pybullet.robot_body import RobotBody
 from pfctl.backends.pybullet.walkers import Walker, make_walkers
 from pfctl.backends.pybullet.world import build_world
 from pfctl.core.mapping.planning import GridPlanner
-from pfctl.core.mapping.walls import house_bounds, rasterize_house
+from pfctl.core.mapping.walls import house_bounds, rasterize_house, segment_distance
 from pfctl.core.robot import (
     STOP,
     GroundTruth,
@@ -91,16 +91,6 @@ class SimOptions:
     """``fast``: vectorised 2-D ray casting; ``bullet``: PyBullet's ``rayTestBatch``."""
     camera: bool = True
     """Render the RGB-D camera (the slowest part of a step)."""
-
-
-def segment_distance(xy: np.ndarray, segs: np.ndarray) -> float:
-    """Distance from the point ``xy`` to the nearest segment row ``[x0, y0, x1, y1]``."""
-    if len(segs) == 0:
-        return math.inf
-    a, b = segs[:, :2], segs[:, 2:]
-    e = b - a
-    t = np.clip(np.sum((xy - a) * e, axis=1) / np.maximum(np.sum(e * e, axis=1), 1e-12), 0, 1)
-    return float(np.min(np.hypot(*(a + t[:, None] * e - xy).T)))
 
 
 class SimRobot:

@@ -46,7 +46,7 @@ MIN_SPEED, MAX_SPEED = 0.3, 1.4
 STEP_ROUND_AFTER = 2.0
 #: … and takes one at most this much longer (m) than the rest of the way it was walking.
 STEP_ROUND_DETOUR = 4.0
-#: A person this near (m) the next stop is there, though the robot keep them from the last step.
+#: A person this near (m) the next stop is there, though the robot keeps them from the last step.
 AT_STOP = 0.1
 #: The first word of the seeds of ``scenario.randomize``'s random streams.
 RANDOMIZE = 7919
@@ -193,7 +193,7 @@ class Walker:
             after = math.hypot(pos[0] - ox, pos[1] - oy)
             if after < clear and after < math.hypot(self.x - ox, self.y - oy):
                 if remaining <= AT_STOP:
-                    self._arrive()  # traced: a person stood 1.5 cm from a stop for good
+                    self._arrive()
                     return
                 self.speed = 0.0
                 self._settle_legs(dt)

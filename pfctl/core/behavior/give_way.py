@@ -39,6 +39,7 @@ from numpy.typing import ArrayLike
 
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap
+from pfctl.core.mapping.walls import segment_distance
 
 XY = tuple[float, float]
 Segment = tuple[XY, XY]
@@ -203,6 +204,7 @@ class GiveWay:
         norm = float(np.linalg.norm(u))
         u = u / norm if norm > 1e-9 else np.array([1.0, 0.0])
         n = np.array([-u[1], u[0]])
+        segs = np.array([(*a, *b) for a, b in ways], dtype=float).reshape(-1, 4)
         best: tuple[float, XY] | None = None
         for direction in (n, -n, (u + n) / math.sqrt(2), (u - n) / math.sqrt(2), u):
             to = np.asarray(here) + self.STEP * direction
@@ -211,11 +213,9 @@ class GiveWay:
                 continue
             if np.min(np.hypot(people[:, 0] - to[0], people[:, 1] - to[1])) < self.CLEAR:
                 continue
-            off_line = abs(float(np.dot(to - np.asarray(person), n)))
-            for a, b in ways:
-                off_line = min(off_line, _distance_to_segment(to, a, b))
-            if best is None or off_line > best[0] + 1e-6:
-                best = (off_line, (float(to[0]), float(to[1])))
+            off = min(abs(float(np.dot(to - np.asarray(person), n))), segment_distance(to, segs))
+            if best is None or off > best[0] + 1e-6:
+                best = (off, (float(to[0]), float(to[1])))
         return None if best is None else best[1]
 
     def hold(self, here: XY) -> XY:
@@ -229,10 +229,3 @@ class GiveWay:
         """The goal was reached or given up: the next goal starts the clock afresh."""
         self.yielding = None
         self._progress = None
-
-
-def _distance_to_segment(p: np.ndarray, a: XY, b: XY) -> float:
-    """Distance from point ``p`` to the segment ``a``–``b``, m."""
-    pa, ab = np.asarray(p) - np.asarray(a), np.subtract(b, a)
-    t = float(np.clip(np.dot(pa, ab) / max(float(np.dot(ab, ab)), 1e-12), 0.0, 1.0))
-    return float(np.linalg.norm(pa - t * ab))

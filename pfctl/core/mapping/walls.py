@@ -182,6 +182,16 @@ def house_geometry(layout: HouseLayout, resolution: float, margin: float = 0.5) 
     )
 
 
+def segment_distance(xy: np.ndarray, segs: np.ndarray) -> float:
+    """Distance from the point ``xy`` to the nearest segment row ``[x0, y0, x1, y1]``."""
+    if len(segs) == 0:
+        return math.inf
+    a, b = segs[:, :2], segs[:, 2:]
+    e = b - a
+    t = np.clip(np.sum((xy - a) * e, axis=1) / np.maximum(np.sum(e * e, axis=1), 1e-12), 0, 1)
+    return float(np.min(np.hypot(*(a + t[:, None] * e - xy).T)))
+
+
 def _mark_lines(mask: np.ndarray, geometry: GridGeometry, segments: Iterable[Segment]) -> None:
     """Mark every cell a segment passes through (its end points excluded), in place.
 
