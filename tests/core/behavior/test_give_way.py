@@ -18,6 +18,7 @@ from pfctl.core.mapping.grid import OccupancyGrid
 from pfctl.core.mapping.house import HouseLayout
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap, SearchParams
+from pfctl.core.mapping.walls import segment_distance
 from pfctl.core.robot import NavStatus, Pose2D
 
 DOOR = (3.9, 6.1)  # the robot, in the office's door, going in
@@ -148,14 +149,8 @@ def test_a_person_in_a_door_of_its_room_gets_a_step_off_the_ways_to_its_other_do
     (hall_door,) = [d for d in doors if math.dist(d, person) <= GiveWay.AT_DOOR]
     for other in doors:
         if other != hall_door:
-            assert _to_segment(aside, hall_door, other) >= 0.5
+            assert segment_distance(np.array(aside), np.array([(*hall_door, *other)])) >= 0.5
     assert give_way.ways(here, (3.0, 1.0), regions) == []  # in the room, at no door
     assert GiveWay().place(here, person, np.array([person]), planner) == pytest.approx(
         (3.10, 3.27), abs=0.02
     )  # without the doors: onto her way to the living room
-
-
-def _to_segment(p: tuple[float, float], a: tuple[float, float], b: tuple[float, float]) -> float:
-    ab, ap = np.subtract(b, a), np.subtract(p, a)
-    t = float(np.clip(np.dot(ap, ab) / np.dot(ab, ab), 0.0, 1.0))
-    return float(np.linalg.norm(ap - t * ab))
