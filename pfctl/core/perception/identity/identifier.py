@@ -136,6 +136,11 @@ CROSSED_S = 5.0
 #: (:meth:`TargetIdentifier._look_alikes_elsewhere`; the crowd's walkers reach 1.5 m/s).
 LOOK_ALIKE_SPEED = 1.5
 
+#: Her named track, back in the camera's view after this long unseen, is judged on the clothes
+#: measured since (``_Evidence.back_at``), s: the tracker may have carried it onto someone else
+#: meanwhile, and what it showed before is the other person's.
+BACK_GAP_S = 0.5
+
 #: Numbers the identifiers, for their job keys.
 _IDENTIFIERS = itertools.count()
 
@@ -249,6 +254,10 @@ class _Evidence:
     clear_clothes: list[float] = field(default_factory=list)
     """Relit clothes samples taken while no other person's box overlapped this one's (a person
     half hidden behind another shows partly the other's clothes)."""
+    back_at: int = 0
+    """The index of the first clothes sample since the track, named, came back into the
+    camera's view after :data:`BACK_GAP_S` or more unseen (0: from the start): its clothes
+    evidence is what it showed since."""
 
     def face(self, recent: int) -> float | None:
         """The median distance of the newest ``recent`` face samples (None: no face yet): a
@@ -258,18 +267,17 @@ class _Evidence:
         return float(np.median(self.face_distances[-recent:]))
 
     def clothes_now(self, recent: int) -> float | None:
-        """The median clothes similarity of the newest ``recent`` samples (None: never
-        measured): a track the tracker slid onto someone else shows it within a few samples,
-        where the mean over the track's life would hide it for long."""
-        if not self.clothes:
-            return None
-        return float(np.median(self.clothes[-recent:]))
+        """The median clothes similarity of the newest ``recent`` samples, taken since the track
+        last came back into view (``back_at``; None: never measured): a track the tracker slid
+        onto someone else shows it within a few samples, where the mean over the track's life
+        would hide it for long."""
+        fresh = self.clothes[self.back_at :][-recent:]
+        return float(np.median(fresh)) if fresh else None
 
     def relit_now(self, recent: int) -> float | None:
         """:meth:`clothes_now` of the relit similarities."""
-        if not self.clothes_relit:
-            return None
-        return float(np.median(self.clothes_relit[-recent:]))
+        fresh = self.clothes_relit[self.back_at :][-recent:]
+        return float(np.median(fresh)) if fresh else None
 
 
 @dataclass(frozen=True)
@@ -560,6 +568,13 @@ class TargetIdentifier:
             s = s if online is None else max(s, online)
             relit = relit if online_relit is None else max(relit, online_relit)
         first = not ev.clothes
+        if not first and t - ev.last_clothes >= BACK_GAP_S - STAMP_EPS and self._is_named(ev):
+            # back in view: the tracker may have carried her track onto someone else meanwhile
+            # (traced, the crowd, seed 13: it coasted out of view onto a passer-by and came
+            # back in his clothes, S 0.00, her clothes still the median of its newest five
+            # samples for 0.2 s — a switch); it is judged on what it shows from now on
+            ev.back_at = len(ev.clothes)
+        ev.last_clothes = t
         ev.clothes.append(s)
         ev.clothes_relit.append(max(s, relit))
         ev.upper = appearance.upper if appearance.upper is not None else ev.upper
@@ -568,6 +583,10 @@ class TargetIdentifier:
             self._link(ev, t)
         elif ev.distractor is not None:
             self._check_slid_off_distractor(ev, appearance)
+
+    def _is_named(self, ev: _Evidence) -> bool:
+        """Whether ``ev`` is the evidence of the named track."""
+        return self._named is not None and ev is self._tracks.get(self._named)
 
     def _check_slid_off_distractor(self, ev: _Evidence, appearance: Appearance) -> None:
         """A track known not to be her without a face (``coexisted``, ``linked``) whose clothes
@@ -620,7 +639,7 @@ class TargetIdentifier:
             p.clothes_recheck_s - STAMP_EPS
         ):
             return True
-        if self._named is not None and ev is self._tracks.get(self._named):
+        if self._is_named(ev):
             return True  # hers: a slide onto someone else shows within a few frames
         crossed = self._crossed
         if (

@@ -523,6 +523,28 @@ def test_someone_in_her_clothes_where_she_cannot_be_leaves_her_clothes_no_eviden
         assert named[-1] == (None if look_alike else 3), look_alike
 
 
+def test_her_track_back_in_view_in_other_clothes_loses_the_name_at_once(learned) -> None:
+    """The crowd, seed 13: her named track coasted out of the camera's view onto a passer-by and
+    came back in his clothes, her clothes still the median of its newest five samples: it kept
+    the name 0.2 s on him (a switch). Back in view after ``BACK_GAP_S`` unseen, the track is
+    judged on what it shows since: one sample clearly unlike her takes the name at once. Seen
+    all along, one such sample (a glimpse of someone passing in front) does not."""
+    profile, params, encoder = learned
+    for unseen in (True, False):
+        ident = TargetIdentifier(profile, params, encoder)
+        for k in range(10):
+            face = TARGET_FACE if k == 0 else None
+            ident.observe(1, 0.1 * k, True, *_at(_picture(RED, face), 0.0, 0.0))
+        assert ident.target_track() == 1
+        for k in range(10, 16):  # unseen: legs tracked, the camera does not see the track
+            ident.observe(
+                1, 0.1 * k, True, *((None, None) if unseen else _at(_picture(RED, None), 0.0, 0.0))
+            )
+            assert ident.target_track() == 1
+        ident.observe(1, 1.6, True, *_at(_picture(GREEN, None), 0.3, 0.0))
+        assert ident.target_track() == (None if unseen else 1), unseen
+
+
 def test_a_person_rejected_by_face_stays_rejected_when_their_track_is_made_again(learned) -> None:
     """A look-alike's face rejects track 2; the tracker loses it and makes track 3 where it
     was a second later, seen from behind in her clothes: still not her, never named. A face of
