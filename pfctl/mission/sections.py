@@ -210,6 +210,7 @@ class IdentityConfig(CoreSection, core=(IdentityParams, ClothesParams)):
     min_face_px: FromCore
     face_miss_limit: FromCore
     face_miss_backoff_s: FromCore
+    face_to_rename: FromCore
 
 
 class PerceptionConfig(MissionModel):

@@ -66,7 +66,7 @@ def test_every_core_key_has_the_core_default_and_meaning() -> None:
             assert field.default == core.default, f"{section.__name__}.{key}"
             assert field.description == param_info(source, name).describe()
             keys += 1
-    assert keys == 68
+    assert keys == 69
 
 
 def test_the_default_mission_builds_the_core_defaults() -> None:

@@ -891,8 +891,9 @@ class TargetIdentifier:
         her on from it (:meth:`_took_her_on`) and is decided TARGET :data:`SPLIT_FRAMES` times
         in a row; else a track a face decides TARGET at once; else a track decided TARGET on
         ``confirm_frames`` identifications in a row over ``confirm_s`` (without a face that can
-        only happen while no look-alike is about: her clothes are no evidence then); else no
-        one — she is lost, and the robot searches."""
+        only happen while no look-alike is about: her clothes are no evidence then; and with
+        ``face_to_rename``, once she was named, only to a track that held her name,
+        :meth:`_face_to_rename`); else no one — she is lost, and the robot searches."""
         named = self._latest.get(self._named) if self._named is not None else None
         doubted = named is not None and self._doubted(named, t)
         if named is not None and doubted:
@@ -929,13 +930,28 @@ class TargetIdentifier:
                 ident.face_distance is not None and ident.face_distance < self.params.face_distance
             )
             ev = self._tracks[tid]
-            if not face and (not self._confirmed(ev, t) or tid in self._astray):
+            if not face and (
+                not self._confirmed(ev, t) or tid in self._astray or self._face_to_rename(tid)
+            ):
                 continue
             key = (int(face), ident.log_odds, ident.last_seen)
             if best is None or key > best[0]:
                 best = (key, tid)
         self._named = None if best is None else best[1]
         self._named_once |= self._named is not None
+
+    def _face_to_rename(self, track_id: int) -> bool:
+        """Whether only her face can name ``track_id`` now (``face_to_rename``): she was named
+        once (by the hand-off or after it), faces are searched, and the track never held her
+        name. A person in her clothes the robot has never seen may be about at any time — in a
+        home it has not seen every person of — and once she is lost, nothing else tells her
+        from them."""
+        return (
+            self.params.face_to_rename
+            and self._named_once
+            and self.searches_faces
+            and track_id not in self._hers
+        )
 
     def _holder(self, now: float) -> _Evidence | None:
         """The evidence of the track that holds her name, or held it until at most

@@ -99,6 +99,15 @@ class IdentityParams:
         unit="s",
         ge=0,
     )
+    face_to_rename: bool = param(
+        False,
+        "Once she has been named, a track that never held her name is named only on her face"
+        " (or as the track that took her on from hers). False: also on her clothes, confirmed"
+        " over ``confirm_frames`` and ``confirm_s``, while no look-alike is known to be about."
+        " Turn it on where people may dress like her before the robot has seen them (uniforms,"
+        " a crowd): no one is then followed on clothes alone, and she is found again only once"
+        " the robot sees her face.",
+    )
     doubt_s: float = param(
         1.0,
         "A named track whose belief stays below the accepting log-odds this long (a face that"

@@ -523,6 +523,42 @@ def test_someone_in_her_clothes_where_she_cannot_be_leaves_her_clothes_no_eviden
         assert named[-1] == (None if look_alike else 3), look_alike
 
 
+def test_once_she_was_named_a_track_new_in_her_clothes_is_named_only_on_her_face(learned) -> None:
+    """Generated home 12 with two look-alikes: she was named, then lost; 6 s later a look-alike
+    the camera had never seen walked in her clothes, back turned, 2 m from where she was lost,
+    and was named on clothes alone 2 s later. With ``face_to_rename``, once she was named, a
+    track that never held her name is named only on her face: it stays the candidate to go and
+    see, however long it shows her clothes, and her face names it at once. Without it (the
+    default), clothes confirmed over ``confirm_s`` name it."""
+    profile, params, encoder = learned
+    for face_to_rename in (True, False):
+        ident = TargetIdentifier(profile, replace(params, face_to_rename=face_to_rename), encoder)
+        for k in range(10):
+            t = 0.1 * k
+            ident.note_tracks(t, [(1, 0.0, 0.0, True)])
+            face = TARGET_FACE if k == 0 else None
+            ident.observe(1, t, True, *_at(_picture(RED, face), 0.0, 0.0))
+        assert ident.target_track() == 1
+        ident.forget(1)  # lost
+        named, candidates = [], []
+        for k in range(60, 100):
+            t = 0.1 * k
+            ident.note_tracks(t, [(2, 2.0, 0.0, True)])
+            ident.observe(2, t, True, *_at(_picture(RED, None), 2.0, 0.0))
+            named.append(ident.target_track())
+            candidates.append(ident.candidate_track())
+        if face_to_rename:
+            assert set(named) == {None} and set(candidates) == {2}
+            for k in range(100, 110):  # she turns round: her face
+                ident.observe(2, 0.1 * k, True, *_at(_picture(RED, TARGET_FACE), 2.0, 0.0))
+                if ident.target_track() == 2:
+                    break
+            assert ident.target_track() == 2 and ident.identity(2).basis == "face"
+            assert 0.1 * k - 10.0 <= params.face_miss_backoff_s + params.face_latency_s + 1e-6
+        else:
+            assert named[0] is None and named[-1] == 2
+
+
 def test_her_track_back_in_view_in_other_clothes_loses_the_name_at_once(learned) -> None:
     """The crowd, seed 13: her named track coasted out of the camera's view onto a passer-by and
     came back in his clothes, her clothes still the median of its newest five samples: it kept
