@@ -943,9 +943,8 @@ class TargetIdentifier:
     def _face_to_rename(self, track_id: int) -> bool:
         """Whether only her face can name ``track_id`` now (``face_to_rename``): she was named
         once (by the hand-off or after it), faces are searched, and the track never held her
-        name. A person in her clothes the robot has never seen may be about at any time — in a
-        home it has not seen every person of — and once she is lost, nothing else tells her
-        from them."""
+        name. Someone in her clothes whom the robot has not seen yet may be about at any time,
+        and once she is lost nothing but a face tells her from them."""
         return (
             self.params.face_to_rename
             and self._named_once
