@@ -271,12 +271,12 @@ class _Evidence:
         last came back into view (``back_at``; None: never measured): a track the tracker slid
         onto someone else shows it within a few samples, where the mean over the track's life
         would hide it for long."""
-        fresh = self.clothes[self.back_at :][-recent:]
+        fresh = self.clothes[max(self.back_at, len(self.clothes) - recent) :]
         return float(np.median(fresh)) if fresh else None
 
     def relit_now(self, recent: int) -> float | None:
         """:meth:`clothes_now` of the relit similarities."""
-        fresh = self.clothes_relit[self.back_at :][-recent:]
+        fresh = self.clothes_relit[max(self.back_at, len(self.clothes_relit) - recent) :]
         return float(np.median(fresh)) if fresh else None
 
 
