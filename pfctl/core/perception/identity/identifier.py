@@ -742,6 +742,7 @@ class TargetIdentifier:
         relit = ev.relit_now(p.clothes_recent)
         now = ev.last_seen
         self._check_unlike(ev, relit, now)  # before the faces: it may forget them
+        self._check_turned_hers(track_id, ev)
         face_d = ev.face(p.face_recent)
         best = min(ev.face_distances) if ev.face_distances else None
         if face_d is not None and face_d >= p.face_distance:
@@ -821,6 +822,32 @@ class TargetIdentifier:
         if math.isfinite(ev.last_match):
             ev.face_distances.clear()
             ev.last_match = ev.last_face = -math.inf
+
+    def _check_turned_hers(self, track_id: int, ev: _Evidence) -> None:
+        """A track whose clothes were clearly unlike hers and now show hers (:meth:`_dressed_now`),
+        and whose faces, none seen since they were unlike, were none of them hers, has slid onto
+        someone in her clothes: the tracker swapped two tracks as two people crossed. The faces
+        it showed are the other person's, so they are forgotten, and so is the memory of them as
+        a person rejected by face — the mirror of :meth:`_check_unlike`. A track that showed her
+        face keeps it: her face decides, whatever its clothes measured then. Traced, the crowd,
+        seed 16: a passer-by crossed her 2.4 s in; her named track took his legs (its clothes
+        turned unlike hers, and the name went), and his track, rejected by his face (0.86), took
+        hers. His face kept her track "not her", and, on a track in her clothes, said that a
+        look-alike was about, so her clothes counted for no one for two minutes. Who the track
+        follows now is not known (her, or a look-alike it met), so, as after a slide off a
+        distractor (:meth:`_check_slid_off_distractor`), her clothes name it only when it took
+        her on from her named track (:meth:`_took_her_on`); else its face does, and until then
+        it is someone to go and see."""
+        if not ev.face_distances or math.isfinite(ev.last_match):
+            return
+        if ev.last_face > ev.unlike_until or not self._dressed_now(ev):
+            return
+        ev.face_distances.clear()
+        ev.last_match = ev.last_face = -math.inf
+        ev.slid = True
+        known = self.distractors.people.get(track_id)
+        if known is not None and known.why == "face":
+            self.distractors.forget(track_id)
 
     def _dressed_now(self, ev: _Evidence) -> bool:
         """Whether a track shows her clothes now: its median and its newest sample match hers

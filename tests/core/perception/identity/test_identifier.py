@@ -1084,6 +1084,37 @@ def test_a_passer_by_swapped_with_her_hands_her_name_to_his_track(learned) -> No
         assert names[-1] == named_after, (look_alike_at, names)
 
 
+def test_a_passer_by_rejected_by_his_face_and_swapped_with_her_hands_her_name_on(learned) -> None:
+    """The crowd, seed 16: a passer-by in other clothes, rejected by his face, crossed her
+    2.4 s in; the tracker swapped the two tracks. Her named track turned to his clothes (the
+    name went), and his track turned to hers, but kept his face: "not her" on her, and, on a
+    track in her clothes, a look-alike about, so clothes counted for no one for two minutes;
+    she was never named again. The faces a track showed while its clothes were unlike hers
+    are forgotten once it shows hers: his track, which took her on, is named on her clothes."""
+    profile, params, encoder = learned
+    params = replace(params, clothes_recheck_s=0.0)
+    her, back = _picture(RED, TARGET_FACE), _picture(RED, None)
+    green, his_face = _picture(GREEN, None), _picture(GREEN, OTHER_FACE)
+    ident = TargetIdentifier(profile, params, encoder)
+    for k in range(30):  # her, named on her face; he walks 0.3 m beside her, face to the robot
+        t = 0.1 * k
+        ident.note_tracks(t, [(1, 2.0, 0.0, True), (2, 2.0, 0.3, True)])
+        ident.observe(1, t, True, *_at(her if k == 0 else back, 2.0, 0.0))
+        ident.observe(2, t, True, *_at(his_face if k < 10 else green, 2.0, 0.3))
+    assert ident.target_track() == 1
+    assert ident.identity(2).decision is Decision.NOT_TARGET  # his face is not hers
+    names = []
+    for k in range(30, 40):  # the tracks swapped as he passed her
+        t = 0.1 * k
+        ident.note_tracks(t, [(1, 2.0, 0.3, True), (2, 2.0, 0.0, True)])
+        ident.observe(1, t, True, *_at(green, 2.0, 0.3))
+        ident.observe(2, t, True, *_at(back, 2.0, 0.0))
+        names.append(ident.target_track())
+    assert names[2] is None  # his clothes on her track: the name went
+    assert names[-1] == 2, names  # his track took her on: her name follows her
+    assert ident.identity(2).face_distance is None  # his face is forgotten
+
+
 def test_after_a_passer_by_crossed_her_out_of_view_the_one_in_her_clothes_is_named(
     learned,
 ) -> None:
