@@ -75,6 +75,15 @@ class PredictionRecord:
 
 
 @dataclass(frozen=True)
+class SpeechRecord:
+    """What the robot said (:class:`~pfctl.core.robot.Speaker`), when, and where it stood."""
+
+    t: float
+    xy: tuple[float, float]
+    text: str
+
+
+@dataclass(frozen=True)
 class RoomPredictionRecord:
     """Which room the lost target is in ``horizon_s`` after the loss at ``t``, as the belief over
     where she can be predicts it (``ranked``, most likely first), beside Algorithm 1's answer:
@@ -365,6 +374,8 @@ class EpisodeLog:
     room_predictions: list[RoomPredictionRecord] = field(default_factory=list)
     target_name: str | None = None
     """The scenario's target (simulator), for the metrics."""
+    speech: list[SpeechRecord] = field(default_factory=list)
+    """What the robot said aloud, in order."""
     tracks: PackedRecords[TrackRow] = field(default_factory=packed_factory(TrackRowCodec))
     """After each laser scan a tick fed to the perception (before its camera frame), one row per
     confirmed track seen then (coasting ones are left out), stamped with the scan: what
@@ -387,6 +398,7 @@ __all__ = [
     "GroundTruthCodec",
     "PredictionRecord",
     "RoomPredictionRecord",
+    "SpeechRecord",
     "TickCodec",
     "TickColumns",
     "TickRecord",

@@ -20,7 +20,8 @@ timed) on its own:
    head (:class:`~pfctl.core.behavior.intents.Intents`), never commands; a head no leaf pointed
    follows the gaze rule (:func:`~pfctl.core.control.gaze_rule`: target, belief, legs);
 5. :meth:`~Follower.act` — the one place that sends the tick's intents to the robot (the head's
-   PD controller turns the head intents into a joint command);
+   PD controller turns the head intents into a joint command; what a leaf says goes to a robot
+   that speaks, :class:`~pfctl.core.robot.Speaker`);
 6. :meth:`~Follower.log_tick` — a :class:`~pfctl.core.episode.TickRecord`: awareness (visible /
    tracked / lost / predicted / searching), the active action, the base mode, the gaze.
 
@@ -75,6 +76,7 @@ from pfctl.core.episode import (
     EpisodeLog,
     PredictionRecord,
     RoomPredictionRecord,
+    SpeechRecord,
     TickRecord,
     WaypointRecord,
 )
@@ -99,7 +101,7 @@ from pfctl.core.prediction.models import (
     PredictionError,
     make_model,
 )
-from pfctl.core.robot import STOP, HeadTarget, LaserScan, Observation, Pose2D, Robot
+from pfctl.core.robot import STOP, HeadTarget, LaserScan, Observation, Pose2D, Robot, Speaker
 from pfctl.core.search.gaze import UnseenGaze
 from pfctl.core.search.next_look import doorway
 from pfctl.core.search.whereabouts import Whereabouts
@@ -197,6 +199,7 @@ class Follower:
         )
         self.navigation = Navigation()
         self.intents = Intents(params.control, self.world, self.navigation)
+        self.intents.can_speak = isinstance(robot, Speaker) and robot.speaks
         self.gaze = GazeController(params.control)
         """The head's PD joint controller (act: one step per head intent)."""
         self.unseen_gaze = (
@@ -497,13 +500,17 @@ class Follower:
         """Send the tick's intents to the robot: the one place the follower commands it. The
         base intent becomes its Robot-port call; each head intent is one step of the head's PD
         controller toward it (:class:`~pfctl.core.control.GazeController`) and the last
-        step's joint command is sent."""
+        step's joint command is sent; what a leaf says is said (and logged)."""
         self._send_base()
         command: HeadTarget | None = None
         for intent in self.intents.head:
             command = self.gaze.update(obs.head, self._head_goal(obs.pose, intent), self.dt)
         if command is not None:
             self.robot.point_head(command)
+        text = self.intents.speech
+        if text is not None and isinstance(self.robot, Speaker):
+            self.robot.say(text)
+            self.log.speech.append(SpeechRecord(obs.stamp, (obs.pose.x, obs.pose.y), text))
 
     def _send_base(self) -> None:
         base = self.intents.base

@@ -1,6 +1,7 @@
 """The Robot port (DESIGN.md): what the follower needs from any robot, simulated or real.
 
-Every backend (``backends/pybullet``, ``backends/hsr``) implements :class:`Robot`. The follower
+Every backend (``backends/pybullet``, ``backends/hsr``) implements :class:`Robot`; a robot that
+can speak also implements :class:`Speaker`, which the follower uses when it is there. The follower
 only ever sees :class:`Observation`; ground truth (:class:`GroundTruth`) travels beside it for
 metrics and recording and must never be read by the follower's decisions.
 
@@ -320,4 +321,21 @@ class Robot(Protocol):
 
     def close(self) -> None:
         """Stop the base and release resources; safe to call twice, also after errors."""
+        ...
+
+
+@runtime_checkable
+class Speaker(Protocol):
+    """A robot with a voice (text-to-speech): optional beside :class:`Robot`, which stays what
+    DESIGN.md names. A person who shows the robot only their back hears it ask to see their
+    face (:class:`~pfctl.core.behavior.leaves.WaypointSearch`); a robot without a voice goes
+    round to their front instead."""
+
+    @property
+    def speaks(self) -> bool:
+        """Whether :meth:`say` is heard (False: the robot was given no voice to speak with)."""
+        ...
+
+    def say(self, text: str) -> None:
+        """Say ``text`` aloud; returns at once, the speech goes on meanwhile."""
         ...

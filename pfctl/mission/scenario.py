@@ -114,6 +114,9 @@ class ScenarioConfig(MissionModel):
     """Extra distractors with random clothes, speeds and looping routes drawn from ``seed``."""
     randomize: ScenarioRandomization = ScenarioRandomization()
     """Further per-seed variation for benchmark campaigns; all off by default."""
+    turn_to_voice: bool = True
+    """People standing within earshot of the robot (4 m, no wall between) turn to face it when
+    it speaks, and back after a few seconds, as people do (false: they never do)."""
 
     @model_validator(mode="after")
     def _names(self) -> ScenarioConfig:

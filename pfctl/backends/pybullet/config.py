@@ -105,6 +105,9 @@ class ScenarioConfig:
     people: tuple[PersonConfig, ...]
     random_people: int
     randomize: Randomization
+    turn_to_voice: bool
+    """People standing within earshot turn to the robot when it speaks
+    (:class:`~pfctl.backends.pybullet.walkers.Earshot`)."""
 
 
 @dataclass(frozen=True)

@@ -29,6 +29,8 @@ wanders slowly, std ``pose_noise.localization_*``; each scan's pose is the laser
 robot believes it, so the scan lands in the map as it would on the real robot) and the odometry
 (integrated from the motion with ``pose_noise.odometry_*`` noise, so it drifts; its frame
 starts at the start pose).
+:meth:`SimRobot.say` (the robot's voice, :class:`~pfctl.core.robot.Speaker`) turns the people
+standing within earshot toward the robot, unless ``scenario.turn_to_voice`` is off.
 :meth:`SimRobot.ground_truth` is kept apart for metrics and recording. MOVE_BASE itself plans
 with the true pose. Everything random is drawn from the config's seed, so the same config gives
 the same episode; ``gui`` opens PyBullet's window and ``realtime`` paces the steps to the clock.
@@ -52,7 +54,7 @@ from pfctl.backends.pybullet.laser import BulletLaser, FastLaser, LaserSpec
 from pfctl.backends.pybullet.navigation import Navigator
 from pfctl.backends.pybullet.people_bodies import PeopleBodies
 from pfctl.backends.pybullet.robot_body import RobotBody
-from pfctl.backends.pybullet.walkers import Walker, make_walkers
+from pfctl.backends.pybullet.walkers import Earshot, Walker, make_walkers
 from pfctl.backends.pybullet.world import build_world
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.walls import house_bounds, rasterize_house, segment_distance
@@ -106,6 +108,9 @@ class SimRobot:
         self.people: list[Walker] = make_walkers(
             config.scenario, house.layout, self.planner, self.seed
         )
+        self.earshot = Earshot(house.layout)
+        self.said: list[tuple[float, str]] = []
+        """What the robot said (:meth:`say`), and when."""
         self.navigator = Navigator(self.planner, rc.max_linear_speed, rc.max_angular_speed)
         self.laser_spec = LaserSpec.from_config(config.laser)
         rngs = [np.random.default_rng([self.seed, k]) for k in range(4)]
@@ -210,6 +215,23 @@ class SimRobot:
     def cancel(self) -> None:
         self.navigator.cancel()
         self._navigating, self._cmd = False, STOP
+
+    @property
+    def speaks(self) -> bool:
+        """The simulated robot has a voice (:class:`~pfctl.core.robot.Speaker`)."""
+        return True
+
+    def say(self, text: str) -> None:
+        """Say ``text``: the people standing within earshot turn to the robot
+        (:meth:`~pfctl.backends.pybullet.walkers.Walker.hear`), unless the scenario's
+        ``turn_to_voice`` is off."""
+        self.said.append((self.time, text))
+        if not self.config.scenario.turn_to_voice:
+            return
+        here = (self.pose.x, self.pose.y)
+        for walker in self.people:
+            if self.earshot.hears(here, (walker.x, walker.y)):
+                walker.hear(*here)
 
     def step(self) -> None:
         """Advance one control period (``tick_period``)."""

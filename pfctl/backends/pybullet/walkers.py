@@ -10,7 +10,10 @@ person whose way the robot stands in waits, and after :data:`STEP_ROUND_AFTER` s
 it when there is room (a path no more than :data:`STEP_ROUND_DETOUR` metres longer), as people
 do: nobody stands in a hall for a minute waiting for a robot to move. A person whose next stop
 the robot stands on (within the distance they keep from it) stops short of it, as if there, and
-goes on with the route.
+goes on with the route. A person standing within earshot of the robot when it speaks (the
+robot asks someone who shows it their back to look at it) turns to face it after
+:data:`REACTION_S`, looks at it for :data:`ATTEND_S`, and turns back (:class:`Earshot`,
+:meth:`Walker.hear`); a person walking walks on.
 
 The two legs are what a laser sees (the paper detects people by their legs, §II-E): cylinders of
 :data:`LEG_RADIUS` beside the body centre, swinging forward and back in opposite phase with a
@@ -48,6 +51,14 @@ STEP_ROUND_AFTER = 2.0
 STEP_ROUND_DETOUR = 4.0
 #: A person this near (m) the next stop is there, though the robot keeps them from the last step.
 AT_STOP = 0.1
+#: A person within this distance (m) of the robot, with no wall between, hears it speak …
+HEARING_RANGE = 4.0
+#: … and, standing, turns to face it after this long (s) …
+REACTION_S = 0.8
+#: … looks at it this long (s), and turns back to the way they faced.
+ATTEND_S = 6.0
+#: A door lets the voice through within this distance (m) of its opening.
+DOOR_SLACK = 0.15
 #: The first word of the seeds of ``scenario.randomize``'s random streams.
 RANDOMIZE = 7919
 
@@ -143,6 +154,9 @@ class Walker:
         self.phase = 0.0
         self._pause_left = 0.0
         self.done = not legs
+        self._attend: tuple[float, float, float, float] | None = None
+        """Turned to the robot's voice: where it spoke, the time left (reaction, then looking
+        at it), and the heading to turn back to (:meth:`hear`)."""
 
     @staticmethod
     def _cumulative(path: np.ndarray) -> np.ndarray:
@@ -177,7 +191,9 @@ class Walker:
             self._pause_left = max(self._pause_left - dt, 0.0)
             self.speed = 0.0
             self._settle_legs(dt)
+            self._turn_to_voice(dt)
             return
+        self._attend = None  # walking on: the way ahead turns them
         remaining = float(self._cum[-1]) - self._s
         brake = math.sqrt(max(2.0 * ACCELERATION * remaining, 0.0))
         target = min(self.cruise, brake)
@@ -212,6 +228,31 @@ class Walker:
         self.phase = (self.phase + 2 * math.pi * self._cadence() * dt) % (2 * math.pi)
         if self._s >= float(self._cum[-1]) - 1e-9:
             self._arrive()
+
+    def hear(self, x: float, y: float) -> None:
+        """The robot at ``(x, y)`` spoke within earshot: a person standing turns to face it
+        after :data:`REACTION_S`, looks at it for :data:`ATTEND_S` and turns back; a person
+        walking walks on. Spoken to again while turned, they look on from then."""
+        if not self.paused:
+            return
+        back = self.theta if self._attend is None else self._attend[3]
+        self._attend = (float(x), float(y), REACTION_S + ATTEND_S, back)
+
+    def _turn_to_voice(self, dt: float) -> None:
+        """A standing person's turn toward the robot's voice and back (:meth:`hear`)."""
+        if self._attend is None:
+            return
+        x, y, left, back = self._attend
+        left -= dt
+        if left > ATTEND_S:
+            self._attend = (x, y, left, back)
+            return
+        want = math.atan2(y - self.y, x - self.x) if left > 0 else back
+        turn = (want - self.theta + math.pi) % (2 * math.pi) - math.pi
+        self.theta += float(np.clip(turn, -TURN_RATE * dt, TURN_RATE * dt))
+        self.theta = (self.theta + math.pi) % (2 * math.pi) - math.pi
+        done = left <= 0 and abs(turn) <= TURN_RATE * dt
+        self._attend = None if done else (x, y, left, back)
 
     def _step_round(self, ox: float, oy: float, clear: float) -> None:
         """Walk the rest of this leg round the obstacle at ``(ox, oy)``: re-plan from here to the
@@ -304,6 +345,26 @@ class Walker:
 
     def truth(self) -> PersonTruth:
         return PersonTruth(self.name, self.x, self.y, self.theta, self.speed, self.is_target)
+
+
+class Earshot:
+    """Who hears the robot speak in the house ``layout``: a person within
+    :data:`HEARING_RANGE` of it, the straight line between them crossing no wall (the rooms'
+    outlines, open within :data:`DOOR_SLACK` of each door)."""
+
+    def __init__(self, layout: HouseLayout) -> None:
+        outlines = shapely.union_all([shapely.Polygon(r.polygon).exterior for r in layout.regions])
+        doors = shapely.union_all(
+            [shapely.LineString(d.segment).buffer(DOOR_SLACK) for d in layout.doors]
+        )
+        self.walls = shapely.difference(outlines, doors)
+        shapely.prepare(self.walls)
+
+    def hears(self, robot: tuple[float, float], person: tuple[float, float]) -> bool:
+        """Whether a person at ``person`` hears the robot at ``robot``."""
+        if math.dist(robot, person) > HEARING_RANGE:
+            return False
+        return not self.walls.intersects(shapely.LineString([robot, person]))
 
 
 def _stops(
@@ -471,4 +532,4 @@ def _near(rgb: tuple[int, int, int], jitter: int, rng: np.random.Generator) -> t
     return tuple(int(v) for v in np.clip(moved, 0, 255))  # type: ignore[return-value]
 
 
-__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Walker", "WalkerState", "make_walkers"]
+__all__ = ["LEG_RADIUS", "PERSON_RADIUS", "Earshot", "Walker", "WalkerState", "make_walkers"]

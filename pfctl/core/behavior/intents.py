@@ -11,7 +11,9 @@ tick's final intents into calls on the Robot port. What a leaf can ask for:
   robot, :mod:`~pfctl.core.behavior.give_way`), :meth:`Intents.turn` and
   :meth:`Intents.stop`; an action that drove the base gives it up with :meth:`Intents.release`;
 - the head: :meth:`Intents.look_at` (a point) or :meth:`Intents.set_pan` (joint angles); a tick
-  in which no leaf pointed the head gets the gaze rule's (:func:`~pfctl.core.control.gaze_rule`).
+  in which no leaf pointed the head gets the gaze rule's (:func:`~pfctl.core.control.gaze_rule`);
+- the voice: :meth:`Intents.say`, on a robot that speaks (:attr:`Intents.can_speak`,
+  :class:`~pfctl.core.robot.Speaker`).
 
 A later write replaces an earlier one of the same tick (the last base intent is the one sent); a
 write that needs no robot call (driving on to the goal under way, an arrival with no goal to
@@ -155,6 +157,10 @@ class Intents:
         """The base control law for each following distance a leaf asked for."""
         self.give_way = GiveWay()
         """When the robot, driving to a goal, steps aside for a person waiting for it."""
+        self.can_speak = False
+        """The robot has a voice (:class:`~pfctl.core.robot.Speaker`); set by the follower."""
+        self.speech: str | None = None
+        """What to say this tick (None: nothing)."""
 
     # -- tick bookkeeping -------------------------------------------------------------------------
 
@@ -166,6 +172,7 @@ class Intents:
         self.base_claimed = False
         self.base_mode = "stop"
         self.head = []
+        self.speech = None
 
     def end(self) -> None:
         """After the tree: a tick in which no leaf drove the base cancels the goal no leaf wants,
@@ -321,6 +328,15 @@ class Intents:
         """A leaf that drove the base stops doing so (it was preempted or finished)."""
         if self.navigation.goal is not None:
             self._write(CancelGoal())
+
+    # -- voice ----------------------------------------------------------------------------------
+
+    def say(self, text: str) -> bool:
+        """Say ``text`` this tick; False (nothing said) on a robot without a voice."""
+        if not self.can_speak:
+            return False
+        self.speech = text
+        return True
 
     # -- head -----------------------------------------------------------------------------------
 

@@ -405,6 +405,13 @@ class WaypointSearch(Action):
                 minimum=0.0,
             ),
             param(
+                "ask_s",
+                4.0,
+                "on a robot that speaks: having looked at such a person's back, ask them to look"
+                " at the robot, and wait this long for their face, s (0: never ask; go round)",
+                minimum=0.0,
+            ),
+            param(
                 "glance_s",
                 3.0,
                 "stop and turn to a person standing in sight whom the camera has not seen yet,"
@@ -467,6 +474,8 @@ class WaypointSearch(Action):
     #: the robot goes round to the side they face — and on round them, a side at a time, while
     #: no face decides.
     APPROACH_LOOK_S: ClassVar[float] = 2.0
+    #: What the robot says to a person who shows it their back (``ask_s``).
+    ASK: ClassVar[str] = "Excuse me, could you look at me, please?"
     #: Places in front of them this near head-on, rad, are taken before the rest of
     #: ``face_viewpoint``'s 60° (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`).
     APPROACH_HEAD_ON: ClassVar[float] = math.radians(30.0)
@@ -524,6 +533,8 @@ class WaypointSearch(Action):
         """Where each approach key's candidate last stood still, and when."""
         self._approach_front: dict[int, tuple[tuple[float, float], tuple[float, float]]] = {}
         """The place in front of each candidate last found, and where they stood then."""
+        self._asked: dict[int, float] = {}
+        """Candidates asked to look at the robot, and when."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
         self._glance_on: dict[int, float] = {}
@@ -540,7 +551,11 @@ class WaypointSearch(Action):
         decided, they face away: the robot goes round to a place in front of them
         (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`, taking them to face away
         from where it stood; traced, generated home 28: she stood with her back to the
-        laundry's door, and the robot looked at her back until it gave up). ``approach_s``
+        laundry's door, and the robot looked at her back until it gave up). A robot that
+        speaks first asks them, once, to look at it, and waits ``ask_s`` for the face (traced,
+        the crowd, seeds 7, 10, 29 and 41: she stood facing the office's west wall 0.9 m off, no
+        place in front of her could be reached, and the robot looked at her back until it gave
+        up; people turn to a robot that speaks to them). ``approach_s``
         per person counts from when the robot is within ``APPROACH_NEAR`` of them (traced,
         home 41: 15 s went on the way there, across the room), and the way there may take
         ``APPROACH_TRAVEL_S`` more; the way round to their front does not count
@@ -569,6 +584,9 @@ class WaypointSearch(Action):
         reached = self._approach_reached
         there = reached[1] if reached is not None and reached[0] == track else None
         looked = self._approach_looked.setdefault(track, [])
+        stood = reached is not None and there is not None
+        if self._ask(c, track, stood and self.t - reached[2] >= self.APPROACH_LOOK_S):
+            return True
         if (
             there is not None
             and reached is not None
@@ -603,6 +621,23 @@ class WaypointSearch(Action):
             if round_ is not None and math.isinf(round_[1]):
                 self._approach_round[track] = (round_[0], self.t)
             self.intents.stop()
+        return True
+
+    def _ask(self, c: TargetState, track: int, looked: bool) -> bool:
+        """Ask candidate ``c`` (approach key ``track``) to look at the robot, once, when the
+        robot has ``looked`` at them ``APPROACH_LOOK_S`` from its place with no face decided
+        and it can speak; then stand, head on them, for ``ask_s`` while they turn. True while
+        waiting (the tick's intents are written)."""
+        wait = float(self.params["ask_s"])
+        asked = self._asked.get(track)
+        if asked is None:
+            if not looked or wait <= 0.0 or not self.intents.say(self.ASK):
+                return False
+            asked = self._asked[track] = self.t
+        if self.t - asked >= wait:
+            return False
+        self.intents.look_at(c.xy, "candidate", self._candidate_look_height(c))
+        self.intents.stop()
         return True
 
     def _approach_key(self, c: TargetState) -> int | None:

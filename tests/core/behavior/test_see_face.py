@@ -38,6 +38,8 @@ class Intents:
         self.turns: list[float] = []
         self.nav = "running"
         self.control = ControlParams()
+        self.can_speak = False
+        self.said: list[str] = []
 
     def claim(self, action: str) -> None:
         pass
@@ -54,6 +56,11 @@ class Intents:
 
     def turn(self, wz: float) -> None:
         self.turns.append(wz)
+
+    def say(self, text: str) -> bool:
+        if self.can_speak:
+            self.said.append(text)
+        return self.can_speak
 
     def look_at(
         self, xy: tuple[float, float], source: str = "target", height: float | None = None

@@ -110,6 +110,44 @@ def test_a_candidate_who_shows_no_face_is_seen_from_in_front() -> None:
     assert rig.intents.looks[-1][:2] == (her.xy, "candidate")
 
 
+def test_a_robot_that_speaks_asks_her_once_to_look_at_it_and_waits_before_going_round() -> None:
+    """The crowd, seeds 7, 10, 29 and 41: she stood facing the office's west wall 0.9 m off;
+    no place in front of her could be reached, and the robot looked at her back until it gave
+    up. A robot that speaks asks her, once, to look at it and stands ``ask_s`` waiting for her
+    face, head on her; then, no face decided, it goes round as one without a voice does."""
+    rig = Rig()
+    rig.intents.can_speak = True
+    wait = next(p.default for p in WaypointSearch.spec.params if p.name == "ask_s")
+    her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
+    assert rig.approach(0.0, her, Pose2D(1.0, 3.0))
+    first = rig.intents.goals[-1]
+    rig.intents.nav = "arrived"
+    assert rig.approach(4.0, her, Pose2D(*first))
+    assert rig.approach(4.0 + WaypointSearch.APPROACH_LOOK_S - 0.1, her, Pose2D(*first))
+    assert rig.intents.said == []  # not yet: she may be turning anyway
+    sent, stops = len(rig.intents.goals), rig.intents.stops
+    asked = 4.0 + WaypointSearch.APPROACH_LOOK_S
+    for t in np.arange(asked, asked + wait - 0.05, 0.5):
+        assert rig.approach(float(t), her, Pose2D(*first))
+    assert rig.intents.said == [WaypointSearch.ASK]  # once
+    assert len(rig.intents.goals) == sent  # standing there, not going round
+    assert rig.intents.stops > stops
+    assert rig.intents.looks[-1][:2] == (her.xy, "candidate")
+    assert rig.approach(asked + wait, her, Pose2D(*first))
+    front = rig.intents.goals[-1]
+    assert front[0] > her.x  # round to her front now
+    assert rig.intents.said == [WaypointSearch.ASK]
+    # ask_s 0: never asks, goes round at once
+    quiet = Rig()
+    quiet.leaf.params["ask_s"] = 0.0
+    quiet.intents.can_speak = True
+    assert quiet.approach(0.0, her, Pose2D(1.0, 3.0))
+    quiet.intents.nav = "arrived"
+    assert quiet.approach(4.0, her, Pose2D(*first))
+    assert quiet.approach(asked, her, Pose2D(*first))
+    assert quiet.intents.said == [] and quiet.intents.goals[-1][0] > her.x
+
+
 def test_the_way_up_to_a_candidate_does_not_count_against_approach_s() -> None:
     """Generated home 41: 15 s went on the way to her, across the room, and the robot gave up
     before it was near. ``approach_s`` counts from ``APPROACH_NEAR``; the way there is bounded
