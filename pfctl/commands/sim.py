@@ -496,7 +496,8 @@ def _serve_report(stats: BridgeStats) -> None:
         f"{status} {stats.sim_time:.1f} s simulated{held} in {stats.wall_time:.1f} s "
         f"({stats.real_time_factor:.2f}× real time): {stats.scans} scans, {stats.frames} camera "
         f"frames; received {stats.velocity_commands} velocity commands, {stats.head_commands} "
-        f"head commands, {stats.goals} move_base goals, {stats.viewpoint_stops} viewpoint stops; "
+        f"head commands, {stats.goals} move_base goals, {stats.viewpoint_stops} viewpoint stops, "
+        f"{stats.said} sentences to say; "
         f"{stats.collisions} collisions",
         highlight=False,
     )

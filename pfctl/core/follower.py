@@ -199,7 +199,8 @@ class Follower:
         )
         self.navigation = Navigation()
         self.intents = Intents(params.control, self.world, self.navigation)
-        self.intents.can_speak = isinstance(robot, Speaker) and robot.speaks
+        self._speaker = robot if isinstance(robot, Speaker) else None
+        """The robot's voice, if it has one (whether anyone hears it is asked every tick)."""
         self.gaze = GazeController(params.control)
         """The head's PD joint controller (act: one step per head intent)."""
         self.unseen_gaze = (
@@ -250,11 +251,13 @@ class Follower:
         return self.log_tick(obs, target)
 
     def observe(self) -> Observation:
-        """What the robot senses now (Robot port), and the status of its navigation goal."""
+        """What the robot senses now (Robot port), the status of its navigation goal, and
+        whether anyone hears it speak."""
         obs = self.robot.observe()
         self._now = obs.stamp
         self.robot_pose = (obs.pose.x, obs.pose.y)
         self.navigation.status = self.robot.nav_status()
+        self.intents.can_speak = self._speaker is not None and self._speaker.speaks
         return obs
 
     def perceive(self, obs: Observation) -> TargetState | None:
@@ -508,8 +511,8 @@ class Follower:
         if command is not None:
             self.robot.point_head(command)
         text = self.intents.speech
-        if text is not None and isinstance(self.robot, Speaker):
-            self.robot.say(text)
+        if text is not None and self._speaker is not None:
+            self._speaker.say(text)
             self.log.speech.append(SpeechRecord(obs.stamp, (obs.pose.x, obs.pose.y), text))
 
     def _send_base(self) -> None:

@@ -67,6 +67,10 @@ class HsrConfig(MissionModel):
     """trajectory_msgs/JointTrajectory to the head."""
     move_base: Topic = "/move_base/move"
     """The move_base_msgs/MoveBaseAction server."""
+    speech: Topic | None = "/pfctl/say"
+    """std_msgs/String of what the robot says (it asks a person who shows it their back to look
+    at it), for a text-to-speech node to speak: on an HSR a relay to Toyota's ``/talk_request``.
+    The robot speaks only while some node listens; null: it never does."""
     viewpoint_stop: Topic | None = "/viewpoint_controller/stop"
     """std_srvs/Empty called (when it exists) before the head is commanded; null: never."""
     ground_truth: Topic | None = "/ground_truth"

@@ -84,6 +84,7 @@ PREDICTION_COLOR = "#01665e"
 WAYPOINT_COLOR = "#6a3d9a"
 REACQUIRED_COLOR = "#1a9850"
 LOSS_COLOR = "#b2182b"
+SPEECH_COLOR = "#1f78b4"
 FURNITURE_FACE = "#c8a47e"
 FURNITURE_EDGE = "#7a5230"
 HOW_LABEL = {"prediction": "prediction", "waypoint_search": "way-point search", "other": "other"}
@@ -321,6 +322,35 @@ def _draw_waypoints(ax: Axes, log: EpisodeLog) -> list[object]:
     ]
 
 
+def _draw_speech(ax: Axes, log: EpisodeLog) -> list[object]:
+    """Where the robot spoke (asked someone to look at it), with the time."""
+    for said in log.speech:
+        ax.plot(*said.xy, marker="D", markersize=8, color=SPEECH_COLOR, mec="white", zorder=12)
+        ax.annotate(
+            f"asked t={said.t:.0f} s",
+            said.xy,
+            xytext=(7, -11),
+            textcoords="offset points",
+            fontsize=7.5,
+            color=SPEECH_COLOR,
+            zorder=13,
+            bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.8},
+        )
+    if not log.speech:
+        return []
+    return [
+        Line2D(
+            [],
+            [],
+            linestyle="none",
+            marker="D",
+            markersize=7,
+            color=SPEECH_COLOR,
+            label="robot spoke (asked to see a face)",
+        )
+    ]
+
+
 def _draw_robot_start(ax: Axes, xy: np.ndarray) -> list[object]:
     ok = np.flatnonzero(~np.isnan(xy[:, 0]))
     if len(ok) == 0:
@@ -397,6 +427,7 @@ def trajectory_figure(
             )
         )
     handles += _draw_waypoints(ax, log)
+    handles += _draw_speech(ax, log)
 
     if a.n and metrics.loss_times:
         idx = [_index_at(a.t, t) for t in metrics.loss_times]
@@ -647,6 +678,7 @@ def search_figure(
     handles += _draw_robot_start(ax, a.robot_xy)
     handles += _draw_people(ax, log, a)
     handles += _draw_waypoints(ax, log)
+    handles += _draw_speech(ax, log)
     correct = np.flatnonzero(a.correct)
     if metrics.found and len(correct):
         i = int(correct[0])

@@ -8,6 +8,7 @@ import pytest
 from pfctl.core.episode import (
     EpisodeLog,
     PredictionRecord,
+    SpeechRecord,
     TickRecord,
     WaypointRecord,
 )
@@ -128,7 +129,8 @@ def demo_log() -> EpisodeLog:
         WaypointRecord(float(t[first_search]), (5.0, 7.8), "frontier", "office"),
         WaypointRecord(float(t[first_search]) + 4.0, (3.0, 7.2), "frontier", "office"),
     ]
-    return EpisodeLog(ticks, truths, predictions, waypoints, target_name="alice")
+    speech = [SpeechRecord(float(t[first_search]) + 6.0, (3.0, 7.2), "Excuse me")]
+    return EpisodeLog(ticks, truths, predictions, waypoints, target_name="alice", speech=speech)
 
 
 def _no_truth(log: EpisodeLog) -> EpisodeLog:
@@ -175,8 +177,10 @@ def test_trajectory_figure(layout: HouseLayout) -> None:
     assert any(lab.startswith("target (alice)") for lab in labels)
     assert any(lab.startswith("prediction") for lab in labels)
     assert any(lab.startswith("way-point") for lab in labels)
+    assert "robot spoke (asked to see a face)" in labels
     texts = [t.get_text() for t in fig.axes[0].texts]
     assert "1" in texts and "2" in texts  # numbered way-points
+    assert any(t.startswith("asked t=") for t in texts)
     assert any("following rate" in t for t in texts)
     _assert_png(fig)
 

@@ -31,6 +31,7 @@ class HsrConfig:
     command_velocity: str
     head_command: str
     move_base: str
+    speech: str | None
     viewpoint_stop: str | None
     ground_truth: str | None
     map_frame: str

@@ -17,6 +17,9 @@ tf, publishes the base and head commands, and drives ``move_base`` through actio
   frame is held fixed (``map → odom`` latest, ``odom → frame`` at the stamp), so a slowly
   published localisation does not hold data back; after :data:`TF_WAIT` without a transform at
   the stamp the latest one is used.
+* **voice** — :meth:`HsrRobot.say` (:class:`~pfctl.core.robot.Speaker`) publishes the text on
+  ``speech`` (``std_msgs/String``) for a text-to-speech node; the robot speaks
+  (:attr:`HsrRobot.speaks`) only while some node subscribes to it.
 * **time** — every stamp the follower sees is seconds of ROS time since the robot was opened (the
   episode clock): sim seconds when the master's ``/use_sim_time`` is true and ``/clock`` runs
   (``pfctl sim serve-hsr``), wall seconds on a real robot.
@@ -208,6 +211,8 @@ class HsrRobot:
             raise ValueError(f"connect_timeout must be a positive number, got {timeout}")
         self._closed = False
         self._opened = False
+        self._say_pub: Any = None
+        """The ``speech`` publisher (None: no voice, or not set up yet)."""
         self._lock = threading.Lock()  # data written by the callbacks
         self._cmd_lock = threading.Lock()  # the lost flag and the base command, in order
         self._tick = threading.Condition()  # woken by /clock and by losing the robot
@@ -349,6 +354,13 @@ class HsrRobot:
             cfg.head_command, m["trajectory_msgs.msg"].JointTrajectory, queue_size=1
         )
         self._handles.append(self._head_pub)
+        self._say_pub = (
+            None
+            if cfg.speech is None
+            else rospy.Publisher(cfg.speech, m["std_msgs.msg"].String, queue_size=10)
+        )
+        if self._say_pub is not None:
+            self._handles.append(self._say_pub)
         self._nav = actionlib.SimpleActionClient(
             cfg.move_base, m["move_base_msgs.msg"].MoveBaseAction
         )
@@ -826,6 +838,21 @@ class HsrRobot:
         duration = max(self.period, move / rc.head_max_speed)
         msg = convert.head_target_to_trajectory(HeadTarget(pan, tilt), duration)
         self._calls.call(self._head_pub.publish, msg)
+
+    # -- the voice (Speaker) --------------------------------------------------------------------
+
+    @property
+    def speaks(self) -> bool:
+        """Some node listens to ``speech`` (a text-to-speech node): what is said is heard."""
+        pub = self._say_pub
+        return pub is not None and not self._closed and pub.get_num_connections() > 0
+
+    def say(self, text: str) -> None:
+        """Publish ``text`` on ``speech`` (std_msgs/String) for the text-to-speech node."""
+        if self._say_pub is None or self._closed:
+            return
+        msg = self._msgs["std_msgs.msg"].String(data=text)
+        self._calls.call(self._say_pub.publish, msg)
 
     def _server_ready(self) -> bool:
         """The move_base action server is connected (actionlib's own test, without waiting)."""

@@ -68,7 +68,9 @@ Commands
       ``map`` (or ``odom``, ``base_footprint``: transformed at once) → ``SimRobot.navigate``; a new
       goal preempts the running one; a cancel → ``SimRobot.cancel`` (PREEMPTED); SUCCEEDED and
       ABORTED as the simulated MOVE_BASE ends; feedback (the base's pose) once per period;
-    * ``viewpoint_stop`` (``std_srvs/Empty``): answered and counted.
+    * ``viewpoint_stop`` (``std_srvs/Empty``): answered and counted;
+    * ``speech`` (``std_msgs/String``) → ``SimRobot.say``: the people within earshot turn to the
+      robot.
 """
 
 from __future__ import annotations
@@ -409,6 +411,8 @@ class BridgeStats:
     head_commands: int = 0
     goals: int = 0
     viewpoint_stops: int = 0
+    said: int = 0
+    """Sentences the robot said (``speech``)."""
     collisions: int = 0
     held: float = 0.0
     """Seconds of ROS time the clock ran before the first command (``wait_for_command``)."""
@@ -522,6 +526,8 @@ class SimHsrBridge:
                 queue_size=50,
             ),
         ]
+        if cfg.speech is not None:
+            self._subs.append(rospy.Subscriber(cfg.speech, std.String, self._on_say, queue_size=10))
         if cfg.viewpoint_stop is not None:
             self._service = rospy.Service(
                 cfg.viewpoint_stop, _msgs("std_srvs.srv").Empty, self._on_viewpoint_stop
@@ -596,6 +602,9 @@ class SimHsrBridge:
             return
         self._events.put(("head", target))
 
+    def _on_say(self, msg: Any) -> None:
+        self._events.put(("say", str(msg.data)))
+
     def _on_goal(self, handle: Any) -> None:
         self._events.put(("goal", handle))
 
@@ -627,6 +636,9 @@ class SimHsrBridge:
                 self._start_goal(value)
             elif kind == "cancel":
                 self._cancel_goal(value)
+            elif kind == "say":
+                robot.say(value)
+                self.stats.said += 1
 
     def _start_goal(self, handle: Any) -> None:
         self.stats.goals += 1

@@ -499,7 +499,7 @@ def test_commands_drive_the_served_robot(ros_master, ros_nodes, tmp_path):
         f"pfctl: interrupted (SIGINT) after serving {out.split()[2]} s simulated"
     ]
     assert out.startswith("interrupted after")
-    assert "1 viewpoint stops" in out and "0 collisions" in out
+    assert "1 viewpoint stops, 0 sentences to say" in out and "0 collisions" in out
 
     assert got["use_sim_time"] is True
     assert got["servers"] == [True, True]
@@ -521,6 +521,20 @@ def test_commands_drive_the_served_robot(ros_master, ros_nodes, tmp_path):
     assert got["bad_frame"][0] == rejected and "elsewhere" in got["bad_frame"][1]
     x, y, text = got["people"]["alice"]
     assert 6 <= x <= 12 and 6 <= y <= 9 and text.startswith("target")  # hidden in the bedroom
+
+
+def test_what_the_robot_says_reaches_the_simulated_house(ros_master, ros_nodes, tmp_path):
+    """``HsrRobot`` speaks once a node listens to ``backend.hsr.speech`` (the bridge, standing
+    in for a text-to-speech node); what it says goes to the simulator (``SimRobot.say``)."""
+    bridge = start_bridge(ros_master, tmp_path, "--rate", "2")
+    wait_serving(bridge, tmp_path)
+    driver = (Path(__file__).parent / "nodes" / "hsr_driver.py").read_text()
+    got = probe_result(ros_nodes(driver, "speak"))
+    os.killpg(bridge.pid, signal.SIGINT)
+    code, out, err = finish_bridge(bridge, tmp_path)
+    assert code == 130, err
+    assert got["speaks"] is True
+    assert "1 viewpoint stops, 1 sentences to say" in out
 
 
 def test_wait_for_command_holds_the_episode(ros_master, ros_nodes, tmp_path):

@@ -10,9 +10,14 @@ from pfctl.app.sim import sim_config
 from pfctl.backends.pybullet.config import Clothes
 from pfctl.backends.pybullet.simulation import PERSON_CONTACT_RADIUS, PERSON_COURTESY
 from pfctl.backends.pybullet.walkers import (
+    ATTEND_S,
+    HEARING_RANGE,
     LEG_RADIUS,
     PERSON_RADIUS,
+    REACTION_S,
     STEP_ROUND_AFTER,
+    TURN_RATE,
+    Earshot,
     Walker,
     make_walkers,
 )
@@ -194,3 +199,49 @@ def test_a_person_whose_stop_the_robot_stands_on_stops_short_and_walks_on(
     assert walker.done
     assert np.linalg.norm(track_xy[-1] - (1.0, 5.0)) < 1e-6
     assert np.linalg.norm(track_xy - (robot_x, 5.0), axis=1).min() >= CLEAR - 0.05
+
+
+def test_the_robot_is_heard_in_its_room_and_through_a_door_not_through_a_wall(
+    mission: Mission,
+) -> None:
+    """The robot speaks in the hall at (2.45, 5): heard in the kitchen through its door
+    (x 2.0-2.9 on y = 4), not through the wall beside it, and not beyond HEARING_RANGE."""
+    earshot = Earshot(mission.layout())
+    robot = (2.45, 5.0)
+    assert earshot.hears(robot, (5.0, 5.0))  # the hall, 2.55 m off
+    assert earshot.hears(robot, (2.45, 2.5))  # the kitchen, straight through the door
+    assert not earshot.hears(robot, (4.5, 3.0))  # the kitchen, through the wall
+    assert not earshot.hears(robot, (2.45 + HEARING_RANGE + 0.1, 5.0))  # the hall, too far
+
+
+def test_a_person_standing_turns_to_the_robots_voice_and_back_one_walking_walks_on(
+    planner: GridPlanner,
+) -> None:
+    """She walks east along the hall and stands facing east; the robot speaks 1.5 m behind
+    her. After REACTION_S she turns to face it, as fast as she turns, looks at it for ATTEND_S
+    and turns back east. Spoken to while walking, she walks on facing her way."""
+    walker = Walker(
+        "her",
+        [np.array((1.0, 5.0)), np.array((2.0, 5.0))],
+        planner.with_radius(PERSON_RADIUS),
+        speed=0.8,
+        clothes=Clothes((0, 0, 0), (0, 0, 0)),
+    )
+    walker.hear(0.5, 5.0)  # walking: not turned
+    heading = []
+    while not walker.done:
+        walker.step(DT)
+        heading.append(walker.theta)
+    assert max(abs(h) for h in heading) < 0.05  # faced east all the way
+    walker.hear(0.5, 5.0)
+    seen = []
+    for k in range(int((REACTION_S + ATTEND_S + 3.0) / DT)):
+        walker.step(DT)
+        seen.append(((k + 1) * DT, walker.theta))
+    west = [t for t, h in seen if abs(abs(h) - np.pi) < 0.05]
+    assert west, "never faced the robot"
+    turn = np.pi / TURN_RATE
+    assert REACTION_S + turn - 2 * DT <= west[0] <= REACTION_S + turn + 2 * DT
+    assert REACTION_S + ATTEND_S - 2 * DT <= west[-1] <= REACTION_S + ATTEND_S + DT
+    assert all(abs(h) < 1e-9 for t, h in seen if t >= REACTION_S + ATTEND_S + turn + 2 * DT)
+    assert all(abs(h) < 1e-9 for t, h in seen if t < REACTION_S)  # the reaction

@@ -20,6 +20,8 @@ Scenarios:
 * ``people`` (with ``--keypoints TOPIC``: ``backend.hsr.person_keypoints``): command zero once
   (a bridge holding its episode starts it), then observe ``--frames`` RGB-D frames; report each
   frame's given people, the person detector's positions and the truth of the frame's stamp.
+* ``speak``: wait until the robot speaks (a node listens to ``backend.hsr.speech``), say one
+  sentence, command zero and step a few periods; report whether it spoke.
 """
 
 from __future__ import annotations
@@ -245,11 +247,24 @@ def interrupt_inside_publish(n: int) -> None:
     topics._PublisherImpl.acquire = interrupting
 
 
+def speak(robot: HsrRobot) -> None:
+    deadline = time.monotonic() + 10.0
+    while not robot.speaks and time.monotonic() < deadline:
+        time.sleep(0.05)
+    speaks = robot.speaks
+    robot.say("Excuse me, could you look at me, please?")
+    robot.command(STOP)
+    for _ in range(4):
+        robot.step()
+    say("spoke", speaks=speaks)
+
+
 def main() -> None:
     faulthandler.register(signal.SIGUSR1, all_threads=True)  # a hung driver's stacks
     parser = argparse.ArgumentParser()
     parser.add_argument(
-        "scenario", choices=("observe", "drive", "navigate", "connect", "people", "scans")
+        "scenario",
+        choices=("observe", "drive", "navigate", "connect", "people", "scans", "speak"),
     )
     parser.add_argument("--timeout", type=float, default=15.0)
     parser.add_argument("--pose", default=None, help="backend.hsr.pose")
@@ -290,6 +305,7 @@ def main() -> None:
             "connect": lambda r: None,
             "people": lambda r: people(r, args.frames),
             "scans": lambda r: scans(r, args.periods),
+            "speak": speak,
         }[args.scenario](robot)
 
 
