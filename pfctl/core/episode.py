@@ -374,13 +374,13 @@ class EpisodeLog:
     room_predictions: list[RoomPredictionRecord] = field(default_factory=list)
     target_name: str | None = None
     """The scenario's target (simulator), for the metrics."""
-    speech: list[SpeechRecord] = field(default_factory=list)
-    """What the robot said aloud, in order."""
     tracks: PackedRecords[TrackRow] = field(default_factory=packed_factory(TrackRowCodec))
     """After each laser scan a tick fed to the perception (before its camera frame), one row per
     confirmed track seen then (coasting ones are left out), stamped with the scan: what
     ``pfctl replay`` writes after each scan of a bag
     (:func:`pfctl.core.perception.pipeline.track_rows`)."""
+    speech: list[SpeechRecord] = field(default_factory=list)
+    """What the robot said aloud, in order."""
 
     def __post_init__(self) -> None:
         if not isinstance(self.ticks, PackedRecords):

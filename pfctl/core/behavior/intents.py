@@ -158,7 +158,8 @@ class Intents:
         self.give_way = GiveWay()
         """When the robot, driving to a goal, steps aside for a person waiting for it."""
         self.can_speak = False
-        """The robot has a voice (:class:`~pfctl.core.robot.Speaker`); set by the follower."""
+        """The robot has a voice someone hears (:class:`~pfctl.core.robot.Speaker`); set by the
+        follower each tick."""
         self.speech: str | None = None
         """What to say this tick (None: nothing)."""
 
