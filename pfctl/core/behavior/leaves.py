@@ -476,6 +476,10 @@ class WaypointSearch(Action):
     APPROACH_LOOK_S: ClassVar[float] = 2.0
     #: What the robot says to a person who shows it their back (``ask_s``).
     ASK: ClassVar[str] = "Excuse me, could you look at me, please?"
+    #: The camera on them this long within ``APPROACH_NEAR`` with no face decided, s, they show
+    #: it their back: a robot that speaks asks them then, on its way up to them (a face turned
+    #: to the camera decides within a few face searches, ``face_miss_backoff_s`` apart).
+    ASK_LOOK_S: ClassVar[float] = 1.0
     #: Places in front of them this near head-on, rad, are taken before the rest of
     #: ``face_viewpoint``'s 60° (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`).
     APPROACH_HEAD_ON: ClassVar[float] = math.radians(30.0)
@@ -535,6 +539,8 @@ class WaypointSearch(Action):
         """The place in front of each candidate last found, and where they stood then."""
         self._asked: dict[int, float] = {}
         """Candidates asked to look at the robot, and when."""
+        self._ask_on: dict[int, float] = {}
+        """When the camera first pointed at each candidate within ``APPROACH_NEAR``."""
         self._glanced: dict[int, float] = {}
         """People the camera had not seen, glanced at, and when the glance began."""
         self._glance_on: dict[int, float] = {}
@@ -552,10 +558,11 @@ class WaypointSearch(Action):
         (:func:`~pfctl.core.perception.viewpoints.face_viewpoint`, taking them to face away
         from where it stood; traced, generated home 28: she stood with her back to the
         laundry's door, and the robot looked at her back until it gave up). A robot that
-        speaks first asks them, once, to look at it, and waits ``ask_s`` for the face (traced,
-        the crowd, seeds 7, 10, 29 and 41: she stood facing the office's west wall 0.9 m off, no
-        place in front of her could be reached, and the robot looked at her back until it gave
-        up; people turn to a robot that speaks to them). ``approach_s``
+        speaks asks them, once, to look at it as soon as they show it their back
+        (:meth:`_ask`), and waits for the face until ``ask_s`` has passed before going round
+        (traced, the crowd, seeds 7, 10, 29 and 41: she stood facing the office's west wall
+        0.9 m off, no place in front of her could be reached, and the robot looked at her back
+        until it gave up; people turn to a robot that speaks to them). ``approach_s``
         per person counts from when the robot is within ``APPROACH_NEAR`` of them (traced,
         home 41: 15 s went on the way there, across the room), and the way there may take
         ``APPROACH_TRAVEL_S`` more; the way round to their front does not count
@@ -585,7 +592,7 @@ class WaypointSearch(Action):
         there = reached[1] if reached is not None and reached[0] == track else None
         looked = self._approach_looked.setdefault(track, [])
         stood = reached is not None and there is not None
-        if self._ask(c, track, stood and self.t - reached[2] >= self.APPROACH_LOOK_S):
+        if self._ask(c, track, stood):
             return True
         if (
             there is not None
@@ -623,22 +630,41 @@ class WaypointSearch(Action):
             self.intents.stop()
         return True
 
-    def _ask(self, c: TargetState, track: int, looked: bool) -> bool:
-        """Ask candidate ``c`` (approach key ``track``) to look at the robot, once, when the
-        robot has ``looked`` at them ``APPROACH_LOOK_S`` from its place with no face decided
-        and it can speak; then stand, head on them, for ``ask_s`` while they turn. True while
-        waiting (the tick's intents are written)."""
+    def _ask(self, c: TargetState, track: int, stood: bool) -> bool:
+        """Ask candidate ``c`` (approach key ``track``) to look at the robot, once, when it can
+        speak and the camera has been on them ``ASK_LOOK_S`` within ``APPROACH_NEAR`` with no
+        face decided (:meth:`_shows_back`) — on the way up to them: traced, the shipped house
+        with ``face_to_rename``, seed 4, the robot asked only once at its place 2.2 m from her
+        and ``APPROACH_LOOK_S`` there, 4.2 s after her back came into view, and her face named
+        her 4.2 s later than her clothes would have. While they turn the robot drives on to its
+        place; ``stood`` there, it waits, head on them, until ``ask_s`` has passed since it
+        asked before it goes round them. True while waiting there (the tick's intents are
+        written)."""
         wait = float(self.params["ask_s"])
         asked = self._asked.get(track)
         if asked is None:
-            if not looked or wait <= 0.0 or not self.intents.say(self.ASK):
+            if wait <= 0.0 or not self._shows_back(c, track) or not self.intents.say(self.ASK):
                 return False
             asked = self._asked[track] = self.t
-        if self.t - asked >= wait:
+        if not stood or self.t - asked >= wait:
             return False
         self.intents.look_at(c.xy, "candidate", self._candidate_look_height(c))
         self.intents.stop()
         return True
+
+    def _shows_back(self, c: TargetState, track: int) -> bool:
+        """Whether candidate ``c`` (approach key ``track``) shows the robot their back: the
+        camera (the base's heading plus the head's pan, blackboard ``head``) has pointed within
+        ``GLANCE_ON`` of them, ``APPROACH_NEAR`` m off or nearer (where a face counts), for
+        ``ASK_LOOK_S`` and their face has not decided (they are still the candidate)."""
+        pose = self.bb.pose
+        if math.dist((pose.x, pose.y), c.xy) > self.APPROACH_NEAR:
+            return False
+        bearing = math.atan2(c.y - pose.y, c.x - pose.x)
+        head: HeadState | None = self.bb.head
+        if head is None or abs(wrap_angle(bearing - pose.theta - head.pan)) <= self.GLANCE_ON:
+            self._ask_on.setdefault(track, self.t)
+        return self.t - self._ask_on.get(track, math.inf) >= self.ASK_LOOK_S
 
     def _approach_key(self, c: TargetState) -> int | None:
         """The track under which candidate ``c``'s approach is kept, or None for a walker (not

@@ -110,33 +110,50 @@ def test_a_candidate_who_shows_no_face_is_seen_from_in_front() -> None:
     assert rig.intents.looks[-1][:2] == (her.xy, "candidate")
 
 
-def test_a_robot_that_speaks_asks_her_once_to_look_at_it_and_waits_before_going_round() -> None:
+def test_a_robot_that_speaks_asks_her_once_on_its_way_and_waits_before_going_round() -> None:
     """The crowd, seeds 7, 10, 29 and 41: she stood facing the office's west wall 0.9 m off;
     no place in front of her could be reached, and the robot looked at her back until it gave
-    up. A robot that speaks asks her, once, to look at it and stands ``ask_s`` waiting for her
-    face, head on her; then, no face decided, it goes round as one without a voice does."""
+    up. The shipped house with ``face_to_rename``, seed 4: asked only ``APPROACH_LOOK_S``
+    after it reached its place, her face came 4.2 s after her back was in view. A robot that
+    speaks asks her, once, when the camera has been on her back ``ASK_LOOK_S`` within
+    ``APPROACH_NEAR``, drives on to its place while she turns, and stands there, head on her,
+    until ``ask_s`` has passed since it asked; then, no face decided, it goes round as one
+    without a voice does. Farther off, or the camera elsewhere, it does not ask."""
     rig = Rig()
     rig.intents.can_speak = True
     wait = next(p.default for p in WaypointSearch.spec.params if p.name == "ask_s")
+    look = WaypointSearch.ASK_LOOK_S
     her = TargetState(4, 5.0, 3.0, 0.0, 0.0, 0.0)
-    assert rig.approach(0.0, her, Pose2D(1.0, 3.0))
+    assert rig.approach(0.0, her, Pose2D(1.0, 3.0))  # 4 m off: too far for her face
     first = rig.intents.goals[-1]
-    rig.intents.nav = "arrived"
-    assert rig.approach(4.0, her, Pose2D(*first))
-    assert rig.approach(4.0 + WaypointSearch.APPROACH_LOOK_S - 0.1, her, Pose2D(*first))
+    assert rig.approach(look + 0.5, her, Pose2D(1.9, 3.0))  # 3.1 m off
+    rig.bb.head = HeadState(pan=math.pi / 2, tilt=0.0)  # the camera elsewhere
+    assert rig.approach(2.0, her, Pose2D(2.1, 3.0))  # 2.9 m off
+    assert rig.approach(2.0 + look + 0.5, her, Pose2D(2.1, 3.0))
+    rig.bb.head = HeadState(pan=0.0, tilt=0.0)  # on her from now
+    on = 2.0 + look + 0.5
+    assert rig.approach(on, her, Pose2D(2.2, 3.0))
+    assert rig.approach(on + look - 0.1, her, Pose2D(2.3, 3.0))
     assert rig.intents.said == []  # not yet: she may be turning anyway
     sent, stops = len(rig.intents.goals), rig.intents.stops
-    asked = 4.0 + WaypointSearch.APPROACH_LOOK_S
-    for t in np.arange(asked, asked + wait - 0.05, 0.5):
+    asked = on + look
+    assert rig.approach(asked, her, Pose2D(2.4, 3.0))
+    assert rig.intents.said == [WaypointSearch.ASK]
+    assert len(rig.intents.goals) == sent + 1 and rig.intents.stops == stops  # drives on
+    assert rig.intents.goals[-1] == first
+    rig.intents.nav = "arrived"
+    assert rig.approach(asked + 0.5, her, Pose2D(*first))
+    sent = len(rig.intents.goals)
+    for t in np.arange(asked + 0.5, asked + wait - 0.05, 0.5):  # past APPROACH_LOOK_S there
         assert rig.approach(float(t), her, Pose2D(*first))
-    assert rig.intents.said == [WaypointSearch.ASK]  # once
+    assert asked + wait - 0.5 - WaypointSearch.APPROACH_LOOK_S > asked + 0.5
     assert len(rig.intents.goals) == sent  # standing there, not going round
     assert rig.intents.stops > stops
     assert rig.intents.looks[-1][:2] == (her.xy, "candidate")
     assert rig.approach(asked + wait, her, Pose2D(*first))
     front = rig.intents.goals[-1]
     assert front[0] > her.x  # round to her front now
-    assert rig.intents.said == [WaypointSearch.ASK]
+    assert rig.intents.said == [WaypointSearch.ASK]  # once
     # ask_s 0: never asks, goes round at once
     quiet = Rig()
     quiet.leaf.params["ask_s"] = 0.0
@@ -144,7 +161,7 @@ def test_a_robot_that_speaks_asks_her_once_to_look_at_it_and_waits_before_going_
     assert quiet.approach(0.0, her, Pose2D(1.0, 3.0))
     quiet.intents.nav = "arrived"
     assert quiet.approach(4.0, her, Pose2D(*first))
-    assert quiet.approach(asked, her, Pose2D(*first))
+    assert quiet.approach(4.0 + WaypointSearch.APPROACH_LOOK_S, her, Pose2D(*first))
     assert quiet.intents.said == [] and quiet.intents.goals[-1][0] > her.x
 
 
