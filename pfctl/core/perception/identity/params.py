@@ -100,13 +100,14 @@ class IdentityParams:
         ge=0,
     )
     face_to_rename: bool = param(
-        False,
+        True,
         "Once she has been named, a track that never held her name is named only on her face"
-        " (or as the track that took her on from hers). False: also on her clothes, confirmed"
-        " over ``confirm_frames`` and ``confirm_s``, while no look-alike is known to be about."
-        " Turn it on where people may dress like her before the robot has seen them (uniforms,"
-        " a crowd): no one is then followed on clothes alone, and she is found again only once"
-        " the robot sees her face.",
+        " (or as the track that took her on from hers): someone in her clothes whom the robot"
+        " has not seen yet may be about at any time, and no one is followed on clothes alone."
+        " False: also on her clothes, confirmed over ``confirm_frames`` and ``confirm_s``, while"
+        " no look-alike is known to be about — she is found sooner where no one dresses like"
+        " her and the robot cannot ask her to turn (no voice), at the risk of following a"
+        " look-alike it has not seen yet.",
     )
     doubt_s: float = param(
         1.0,

@@ -526,13 +526,14 @@ def test_someone_in_her_clothes_where_she_cannot_be_leaves_her_clothes_no_eviden
 def test_once_she_was_named_a_track_new_in_her_clothes_is_named_only_on_her_face(learned) -> None:
     """Generated home 12 with two look-alikes: she was named, then lost; 6 s later a look-alike
     the camera had never seen walked in her clothes, back turned, 2 m from where she was lost,
-    and was named on clothes alone 2 s later. With ``face_to_rename``, once she was named, a
-    track that never held her name is named only on her face: it stays the candidate to go and
-    see, however long it shows her clothes, and her face names it at once. Without it (the
-    default), clothes confirmed over ``confirm_s`` name it."""
+    and was named on clothes alone 2 s later. With ``face_to_rename`` (the default), once she
+    was named, a track that never held her name is named only on her face: it stays the
+    candidate to go and see, however long it shows her clothes, and her face names it at once.
+    Without it, clothes confirmed over ``confirm_s`` name it."""
     profile, params, encoder = learned
     for face_to_rename in (True, False):
-        ident = TargetIdentifier(profile, replace(params, face_to_rename=face_to_rename), encoder)
+        chosen = params if face_to_rename else replace(params, face_to_rename=False)
+        ident = TargetIdentifier(profile, chosen, encoder)
         for k in range(10):
             t = 0.1 * k
             ident.note_tracks(t, [(1, 0.0, 0.0, True)])
