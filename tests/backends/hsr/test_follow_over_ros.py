@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import itertools
 import json
 import os
 import signal
@@ -37,6 +38,9 @@ HOUSE = ROOT / "missions" / "house.yaml"
 PFCTL = [sys.executable, "-m", "pfctl"]
 #: Seconds of the episode (ROS time), as in the simulator test.
 EPISODE_S = 60.0
+#: The live run and its replay may move the name this far apart, s (faces come back live when
+#: the worker is done, in the replay after a fixed latency).
+NAMING_SLACK_S = 2.0
 #: Re-identification must come within this long after the loss (the simulator test: 45 s; the
 #: two processes side by side jitter by a tick or two).
 REFIND_WITHIN_S = 50.0
@@ -241,11 +245,28 @@ def _tracks(path: Path) -> list[dict[str, float]]:
         return [{k: float(v) for k, v in row.items()} for row in csv.DictReader(f)]
 
 
+def _naming_moments(rows: list[dict[str, float]]) -> list[float]:
+    """The stamps at which the name moved in a ``tracks.csv`` (to a track, to none, or from one
+    track to another)."""
+    holder: dict[float, float | None] = {}
+    for row in rows:
+        holder.setdefault(row["t"], None)
+        if row["is_target"]:
+            holder[row["t"]] = row["track_id"]
+    stamps = sorted(holder)
+    return [b for a, b in itertools.pairwise(stamps) if holder[a] != holder[b]]
+
+
 def test_replay_of_the_recorded_bag_reproduces_the_live_tracks(
     over_ros: OverRos, tmp_path: Path
 ) -> None:
     """``pfctl replay`` of the rosbag taped from serve-hsr: at the stamps of the live run's
-    rows, the replayed tracks stand where the live ones stood."""
+    rows, the replayed tracks stand where the live ones stood, and the same one is the target
+    — except within ``NAMING_SLACK_S`` of a moment the live run's name moved: live, faces come
+    back from the worker when they are done (``face_timing`` realtime), in the replay after a
+    fixed latency, and after a loss only her face names a track (``face_to_rename``). Traced on
+    ``6689c3f``: 83 of 1339 rows disagreed, 70 of them before the live run named her at 1.0 s
+    and 12 within 0.3 s of her being named again at 40.5 s."""
     assert over_ros.bag.is_file() and over_ros.bag.stat().st_size > 1_000_000
     out = tmp_path / "replay"
     done = subprocess.run(
@@ -261,7 +282,9 @@ def test_replay_of_the_recorded_bag_reproduces_the_live_tracks(
     by_ms: dict[int, list[dict[str, float]]] = {}
     for row in replayed:
         by_ms.setdefault(round(1000 * row["t"]), []).append(row)
+    moments = _naming_moments(live)
     matched = 0
+    settled = 0
     target_agrees = 0
     for row in live:
         ms = round(1000 * (row["t"] + origin))  # the live run logs episode time, the bag ROS time
@@ -269,9 +292,12 @@ def test_replay_of_the_recorded_bag_reproduces_the_live_tracks(
         near = [r for r in same_scan if np.hypot(r["x"] - row["x"], r["y"] - row["y"]) < 0.05]
         if near:
             matched += 1
-            target_agrees += any(r["is_target"] == row["is_target"] for r in near)
+            if all(abs(row["t"] - m) > NAMING_SLACK_S for m in moments):
+                settled += 1
+                target_agrees += any(r["is_target"] == row["is_target"] for r in near)
     assert matched / len(live) > 0.95, f"{matched} of {len(live)} live rows replayed"
-    assert target_agrees / len(live) > 0.95, f"target agrees in {target_agrees} of {len(live)}"
+    assert settled / matched > 0.6, f"{settled} of {matched} rows away from {moments}"
+    assert target_agrees / settled > 0.95, f"target agrees in {target_agrees} of {settled}"
 
 
 def _commands(log: Path) -> list[tuple[float, float, float, float]]:
