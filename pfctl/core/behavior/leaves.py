@@ -634,9 +634,9 @@ class WaypointSearch(Action):
         """Ask candidate ``c`` (approach key ``track``) to look at the robot, once, when it can
         speak and the camera has been on them ``ASK_LOOK_S`` within ``APPROACH_NEAR`` with no
         face decided (:meth:`_shows_back`) — on the way up to them: traced, the shipped house
-        with ``face_to_rename``, seed 4, the robot asked only once at its place 2.2 m from her
-        and ``APPROACH_LOOK_S`` there, 4.2 s after her back came into view, and her face named
-        her 4.2 s later than her clothes would have. While they turn the robot drives on to its
+        with ``face_to_rename``, seed 4, asking only once it had stood ``APPROACH_LOOK_S`` at
+        its place 2.2 m from her, the robot asked 4.2 s after her back came into view, and her
+        face named her 4.2 s later than her clothes would have. While they turn it drives on to its
         place; ``stood`` there, it waits, head on them, until ``ask_s`` has passed since it
         asked before it goes round them. True while waiting there (the tick's intents are
         written)."""
