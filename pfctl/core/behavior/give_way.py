@@ -10,10 +10,15 @@ aside; the robot does.
 :class:`GiveWay` watches the robot drive to its goals (:meth:`GiveWay.check`, called by
 :meth:`~pfctl.core.behavior.intents.Intents.go_to` each tick). When the robot has made no
 progress (``PROGRESS`` m) for ``AFTER_S`` seconds with a person within ``NEAR`` m, it steps
-``STEP`` m out of that person's way — to the side first, off the line from them through the
-robot (the way they want to go, as far as the robot can tell), else back — along a straight line
-that is free on the static map, and holds there until ``FOR_S`` seconds have passed since its
-last step; then it drives on to its goal. When a person stands in its way there (traced, seed
+out of that person's way — to the side first, off the line from them through the robot (the way
+they want to go, as far as the robot can tell), else back — along a straight line that is free
+on the static map, and holds there until they have gone by (nobody within ``NEAR`` m of where
+it stood, ``SETTLE_S`` after its step) or ``FOR_S`` seconds have passed since its last step;
+then it drives on to its goal. The step is ``SIDE_STEP`` m where that takes it ``OUT_OF_WAY`` m
+off their ways, else ``STEP`` m: a robot at the HSR's 0.22 m/s drives each metre of the step
+twice, there and back, in 9 s (traced, the crowd, seeds 14 and 19: the person it gave way to
+had gone through the door 3 s after its step, and it was back where it stood 8.5 s after it,
+for a re-find 1–2 s too late for the episode). When a person stands in its way there (traced, seed
 14: its diagonal step back was where he was going, and he waited), it steps aside again, a few
 times at most; a person walking past it there, as the one it gave way to does, does not make it
 step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off, and
@@ -48,11 +53,12 @@ Segment = tuple[XY, XY]
 @dataclass(frozen=True)
 class Yielding:
     """Giving way since ``since`` (s), at the place ``to``: the ``steps``-th step aside in a
-    row."""
+    row, the first from ``stood`` (where the person waited for the robot)."""
 
     since: float
     to: XY
     steps: int = 1
+    stood: XY | None = None
 
 
 class GiveWay:
@@ -66,6 +72,10 @@ class GiveWay:
     #: The step out of the way, m; the place must be at least ``CLEAR`` m from every person.
     STEP = 1.0
     CLEAR = 0.8
+    #: The shorter step to a side, m, taken where it ends this far off their ways, m: the
+    #: robot's radius (the HSR's 0.215 m), a person's (0.25 m) and some room to pass.
+    SIDE_STEP = 0.7
+    OUT_OF_WAY = 0.6
     #: Giving way (the step and the wait there) lasts this long, s, from the last step.
     FOR_S = 5.0
     #: The robot is at its place this close to it, m; a person standing within ``CLEAR`` m this
@@ -110,6 +120,10 @@ class GiveWay:
         while self._seen[0][0] < now - 2 * self.SETTLE_S:
             self._seen.popleft()
         y = self.yielding
+        if y is not None and not gap and self._gone_by(now, y, pts):
+            y = self.yielding = None
+            self._progress = (now, here)
+            return None
         if y is not None and not gap and now - y.since < self.FOR_S:
             there = math.dist(here, y.to) <= self.ARRIVED
             if there and y.steps < self.STEPS and now - y.since >= self.SETTLE_S:
@@ -156,8 +170,19 @@ class GiveWay:
         to = self.place(here, person, people, planner, ways)
         if to is None:
             return None
-        self.yielding = Yielding(now, to, n)
+        stood = here if self.yielding is None else self.yielding.stood
+        self.yielding = Yielding(now, to, n, stood)
         return to
+
+    def _gone_by(self, now: float, y: Yielding, people: np.ndarray) -> bool:
+        """Whether the people it gave way to have gone by, ``SETTLE_S`` after its last step:
+        nobody stands or walks within ``NEAR`` m of where it stood (they came through it)."""
+        if y.stood is None or now - y.since < self.SETTLE_S:
+            return False
+        if len(people) == 0:
+            return True
+        d = np.hypot(people[:, 0] - y.stood[0], people[:, 1] - y.stood[1])
+        return bool(d.min() > self.NEAR)
 
     def _standing(self, now: float, people: np.ndarray) -> np.ndarray:
         """Which of ``people`` ``(n, 2)`` stand (a boolean mask): someone was within ``STILL`` m
@@ -195,27 +220,37 @@ class GiveWay:
         planner: GridPlanner,
         ways: Sequence[Segment] = (),
     ) -> XY | None:
-        """Where to step out of ``person``'s way: ``STEP`` m from ``here`` to either side, then
-        diagonally back, then straight back (away from them), the first place farthest from
-        the line from them through the robot and from their other ``ways`` (:meth:`ways`),
-        reached in a straight line free on the static map, and ``CLEAR`` m from everyone; None
-        when there is no such place."""
+        """Where to step out of ``person``'s way: to either side, then diagonally back, then
+        straight back (away from them), ``STEP`` m from ``here`` — or ``SIDE_STEP`` m to a side
+        — reached in a straight line free on the static map, and ``CLEAR`` m from everyone.
+        Of those, the nearest that is ``OUT_OF_WAY`` m off the line from them through the robot
+        and off their other ``ways`` (:meth:`ways`), the farther off among equals; else the
+        first place farthest off them. None when there is no such place."""
         u = np.array([here[0] - person[0], here[1] - person[1]])
         norm = float(np.linalg.norm(u))
         u = u / norm if norm > 1e-9 else np.array([1.0, 0.0])
         n = np.array([-u[1], u[0]])
         segs = np.array([(*a, *b) for a, b in ways], dtype=float).reshape(-1, 4)
+        steps = [(self.SIDE_STEP, n), (self.SIDE_STEP, -n)] + [
+            (self.STEP, d) for d in (n, -n, (u + n) / math.sqrt(2), (u - n) / math.sqrt(2), u)
+        ]
         best: tuple[float, XY] | None = None
-        for direction in (n, -n, (u + n) / math.sqrt(2), (u - n) / math.sqrt(2), u):
-            to = np.asarray(here) + self.STEP * direction
+        out: tuple[float, float, XY] | None = None
+        for length, direction in steps:
+            to = np.asarray(here) + length * direction
             line = np.linspace(here, to, 21)
             if not planner.free_mask(line[1:]).all():
                 continue
             if np.min(np.hypot(people[:, 0] - to[0], people[:, 1] - to[1])) < self.CLEAR:
                 continue
             off = min(abs(float(np.dot(to - np.asarray(person), n))), segment_distance(to, segs))
+            xy = (float(to[0]), float(to[1]))
             if best is None or off > best[0] + 1e-6:
-                best = (off, (float(to[0]), float(to[1])))
+                best = (off, xy)
+            if off >= self.OUT_OF_WAY and (out is None or (length, -off) < out[:2]):
+                out = (length, -off, xy)
+        if out is not None:
+            return out[2]
         return None if best is None else best[1]
 
     def hold(self, here: XY) -> XY:
