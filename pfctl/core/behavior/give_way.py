@@ -8,26 +8,24 @@ target stood unseen behind the office's bookshelf. People resolve this by one of
 aside; the robot does.
 
 :class:`GiveWay` watches the robot drive to its goals (:meth:`GiveWay.check`, called by
-:meth:`~pfctl.core.behavior.intents.Intents.go_to` each tick). When the robot has made no
-progress (``PROGRESS`` m) for ``AFTER_S`` seconds with a person within ``NEAR`` m, it steps
-out of that person's way — to the side first, off the line from them through the robot (the way
-they want to go, as far as the robot can tell), else back — along a straight line that is free
-on the static map, and holds there until they have gone by (nobody within ``NEAR`` m of where
-it stood, ``SETTLE_S`` after its step) or ``FOR_S`` seconds have passed since its last step;
-then it drives on to its goal. The step is ``SIDE_STEP`` m where that takes it ``OUT_OF_WAY`` m
-off their ways, else ``STEP`` m: a robot at the HSR's 0.22 m/s drives each metre of the step
-twice, there and back, in 9 s (traced, the crowd, seeds 14 and 19: the person it gave way to
-had gone through the door 3 s after its step, and it was back where it stood 8.5 s after it,
-for a re-find 1–2 s too late for the episode). When a person stands in its way there (traced, seed
-14: its diagonal step back was where he was going, and he waited), it steps aside again, a few
-times at most; a person walking past it there, as the one it gave way to does, does not make it
-step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off, and
-its second and third steps took it 2 m back down the hall, 24 s from giving way to being where it
-gave way again). A person waiting in a door of the robot's room may be going to any other door
-of it, so the step keeps off those ways too (traced, the house, seed 40: a person coming into the
-kitchen from the hall, on her way to the living room's door, waited in the hall's door; the
-robot's step to the side was onto her way, and she walked behind it, 0.6 m off, as it stepped
-twice more, 13 s in all).
+:meth:`~pfctl.core.behavior.intents.Intents.go_to` each tick). When the robot has made no progress
+(``PROGRESS`` m) for ``AFTER_S`` seconds with a person within ``NEAR`` m, it steps out of that
+person's way — to the side first, off the line from them through the robot (the way they want to go,
+as far as the robot can tell), else back — along a straight line that is free on the static map, and
+holds there until they have gone by (nobody within ``NEAR`` m of where it stood, ``SETTLE_S`` after
+its step) or ``FOR_S`` seconds have passed since its last step; then it drives on to its goal. The
+step is ``SIDE_STEP`` m where that takes it ``OUT_OF_WAY`` m off their ways, else ``STEP`` m: a
+robot at the HSR's 0.22 m/s drives each metre of the step twice, there and back, in 9 s, and the
+person it gave way to has mostly gone by long before. When a person stands in its way there (traced,
+the house, seed 14: its diagonal step back was where he was going, and he waited), it steps aside
+again, a few times at most; a person walking past it there, as the one it gave way to does, does not
+make it step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off,
+and its second and third steps took it 2 m back down the hall, 24 s from giving way to being where
+it gave way again). A person waiting in a door of the robot's room may be going to any other door of
+it, so the step keeps off those ways too (traced, the house, seed 40: a person coming into the
+kitchen from the hall, on her way to the living room's door, waited in the hall's door; the robot's
+step to the side was onto her way, and she walked behind it, 0.6 m off, as it stepped twice more,
+13 s in all).
 The robot's MOVE_BASE keeps its own recovery (re-plan, abort); giving way adds the one thing it
 cannot do, moving off the goal's path.
 """
