@@ -74,6 +74,9 @@ class GiveWay:
     #: robot's radius (the HSR's 0.215 m), a person's (0.25 m) and some room to pass.
     SIDE_STEP = 0.7
     OUT_OF_WAY = 0.6
+    #: The robot drives back before ``FOR_S`` only where it sees: within this angle, rad, of
+    #: its heading — ahead or to a side; a base laser's 270° leaves a blind sector behind it.
+    AHEAD = math.radians(100.0)
     #: Giving way (the step and the wait there) lasts this long, s, from the last step.
     FOR_S = 5.0
     #: The robot is at its place this close to it, m; a person standing within ``CLEAR`` m this
@@ -104,6 +107,7 @@ class GiveWay:
         people: ArrayLike,
         planner: GridPlanner,
         regions: RegionMap | None = None,
+        heading: float | None = None,
     ) -> XY | None:
         """The place to give way at this tick (None: drive on to the goal): called on every
         tick the robot drives to a goal, at time ``now`` and position ``here``, with the
@@ -118,7 +122,7 @@ class GiveWay:
         while self._seen[0][0] < now - 2 * self.SETTLE_S:
             self._seen.popleft()
         y = self.yielding
-        if y is not None and not gap and self._gone_by(now, y, pts):
+        if y is not None and not gap and self._gone_by(now, here, heading, y, pts):
             y = self.yielding = None
             self._progress = (now, here)
             return None
@@ -172,11 +176,19 @@ class GiveWay:
         self.yielding = Yielding(now, to, n, stood)
         return to
 
-    def _gone_by(self, now: float, y: Yielding, people: np.ndarray) -> bool:
+    def _gone_by(
+        self, now: float, here: XY, heading: float | None, y: Yielding, people: np.ndarray
+    ) -> bool:
         """Whether the people it gave way to have gone by, ``SETTLE_S`` after its last step:
-        nobody stands or walks within ``NEAR`` m of where it stood (they came through it)."""
+        nobody stands or walks within ``NEAR`` m of where it stood (they came through it), and
+        the way back there lies within ``AHEAD`` of the robot's ``heading`` (rad; None: not
+        known), where its laser sees who is on it."""
         if y.stood is None or now - y.since < self.SETTLE_S:
             return False
+        if heading is not None and math.dist(here, y.stood) > self.ARRIVED:
+            back = math.atan2(y.stood[1] - here[1], y.stood[0] - here[0])
+            if abs((back - heading + math.pi) % (2 * math.pi) - math.pi) > self.AHEAD:
+                return False
         if len(people) == 0:
             return True
         d = np.hypot(people[:, 0] - y.stood[0], people[:, 1] - y.stood[1])

@@ -279,7 +279,9 @@ class Intents:
         if math.dist(here, goal) <= tolerance:
             return self._arrived()
         world = self.world
-        aside = self.give_way.check(self.now, here, world.people_xy, world.planner, world.regions)
+        aside = self.give_way.check(
+            self.now, here, world.people_xy, world.planner, world.regions, self.pose.theta
+        )
         if aside is not None:
             return self._step_aside(aside)
         nav = self.navigation

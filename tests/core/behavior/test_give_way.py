@@ -110,6 +110,33 @@ def test_the_robot_drives_on_once_the_person_it_gave_way_to_has_gone_by(
     assert (intents.base.goal.x, intents.base.goal.y) == pytest.approx(GOAL, abs=0.1)
 
 
+def test_the_robot_drives_back_early_only_where_its_laser_sees_the_way(
+    planner: GridPlanner,
+) -> None:
+    """The crowd, seed 24: the robot had turned on its way to its place, the way back lay
+    behind it, in the laser's blind sector, and a man who stood there unseen was hit as it drove
+    back once the person it gave way to had gone by. With the way back ahead or to a side, it
+    drives back at once; behind it, it holds until ``FOR_S``."""
+    here, person = (6.0, 5.0), (6.6, 5.0)  # in the hall, a person waiting east of it
+    passed = (9.0, 5.0)  # down the hall, out of the way
+    for heading, early in ((math.pi / 2, True), (0.0, True), (-math.pi / 2, False)):
+        give_way = GiveWay()
+        t, aside = 0.0, None
+        while aside is None:
+            aside = give_way.check(t, here, [person], planner, None, heading)
+            t += 0.1
+        assert aside == pytest.approx((6.0, 5.0 - GiveWay.SIDE_STEP))  # south: back is north
+        since, drove_back = t - 0.1, None
+        while drove_back is None:  # there, ticking; the person has gone by
+            if give_way.check(t, aside, [passed], planner, None, heading) is None:
+                drove_back = t - since
+            t += 0.1
+        if early:
+            assert drove_back == pytest.approx(GiveWay.SETTLE_S, abs=0.15), heading
+        else:
+            assert drove_back == pytest.approx(GiveWay.FOR_S, abs=0.15), heading
+
+
 def test_where_a_side_is_free_the_step_is_the_short_one_to_a_side(planner: GridPlanner) -> None:
     """In the hall (nothing but walls near), the robot steps ``SIDE_STEP`` m to a side, off the
     way of the person waiting in front of it, not ``STEP`` m: at 0.22 m/s each metre of the
