@@ -13,19 +13,19 @@ aside; the robot does.
 person's way — to the side first, off the line from them through the robot (the way they want to go,
 as far as the robot can tell), else back — along a straight line that is free on the static map, and
 holds there until they have gone by (nobody within ``NEAR`` m of where it stood, ``SETTLE_S`` after
-its step) or ``FOR_S`` seconds have passed since its last step; then it drives on to its goal. The
-step is ``SIDE_STEP`` m where that takes it ``OUT_OF_WAY`` m off their ways, else ``STEP`` m: a
-robot at the HSR's 0.22 m/s drives each metre of the step twice, there and back, in 9 s, and the
-person it gave way to has mostly gone by long before. When a person stands in its way there (traced,
-the house, seed 14: its diagonal step back was where he was going, and he waited), it steps aside
-again, a few times at most; a person walking past it there, as the one it gave way to does, does not
-make it step again (traced, the house, seed 7: the person it gave way to walked round it, 0.6 m off,
-and its second and third steps took it 2 m back down the hall, 24 s from giving way to being where
-it gave way again). A person waiting in a door of the robot's room may be going to any other door of
-it, so the step keeps off those ways too (traced, the house, seed 40: a person coming into the
-kitchen from the hall, on her way to the living room's door, waited in the hall's door; the robot's
-step to the side was onto her way, and she walked behind it, 0.6 m off, as it stepped twice more,
-13 s in all).
+its step, and the way back ahead of it or to a side, where its laser sees) or ``FOR_S`` seconds have
+passed since its last step; then it drives on to its goal. The step is ``SIDE_STEP`` m where that
+takes it ``OUT_OF_WAY`` m off their ways, else ``STEP`` m: a robot at the HSR's 0.22 m/s drives each
+metre of the step twice, there and back, in 9 s, and the person it gave way to has mostly gone by
+long before. When a person stands in its way there (traced, the house, seed 14: its diagonal step
+back was where he was going, and he waited), it steps aside again, a few times at most; a person
+walking past it there, as the one it gave way to does, does not make it step again (traced, the
+house, seed 7: the person it gave way to walked round it, 0.6 m off, and its second and third steps
+took it 2 m back down the hall, 24 s from giving way to being where it gave way again). A person
+waiting in a door of the robot's room may be going to any other door of it, so the step keeps off
+those ways too (traced, the house, seed 40: a person coming into the kitchen from the hall, on her
+way to the living room's door, waited in the hall's door; the robot's step to the side was onto her
+way, and she walked behind it, 0.6 m off, as it stepped twice more, 13 s in all).
 The robot's MOVE_BASE keeps its own recovery (re-plan, abort); giving way adds the one thing it
 cannot do, moving off the goal's path.
 """
@@ -110,9 +110,10 @@ class GiveWay:
         heading: float | None = None,
     ) -> XY | None:
         """The place to give way at this tick (None: drive on to the goal): called on every
-        tick the robot drives to a goal, at time ``now`` and position ``here``, with the
-        other people's positions ``(n, 2)``, the static map's ``planner`` and the house's
-        ``regions`` (their doors: :meth:`ways`; None: not known). A person standing
+        tick the robot drives to a goal, at time ``now``, position ``here`` and ``heading``
+        (rad; None: not known), with the other people's positions ``(n, 2)``, the static map's
+        ``planner`` and the house's ``regions`` (their doors: :meth:`ways`; None: not known).
+        A person standing
         within ``CLEAR`` m once the robot stands at its place (they came on its way, and wait)
         gets a step aside from there too, up to ``STEPS`` in all."""
         gap = now - self._asked_at > self.GAP_S
