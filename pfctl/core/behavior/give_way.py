@@ -51,7 +51,7 @@ Segment = tuple[XY, XY]
 @dataclass(frozen=True)
 class Yielding:
     """Giving way since ``since`` (s), at the place ``to``: the ``steps``-th step aside in a
-    row, the first from ``stood`` (where the person waited for the robot)."""
+    row, the first from ``stood`` (where the robot stood while the person waited for it)."""
 
     since: float
     to: XY
@@ -113,9 +113,8 @@ class GiveWay:
         tick the robot drives to a goal, at time ``now``, position ``here`` and ``heading``
         (rad; None: not known), with the other people's positions ``(n, 2)``, the static map's
         ``planner`` and the house's ``regions`` (their doors: :meth:`ways`; None: not known).
-        A person standing
-        within ``CLEAR`` m once the robot stands at its place (they came on its way, and wait)
-        gets a step aside from there too, up to ``STEPS`` in all."""
+        A person standing within ``CLEAR`` m once the robot stands at its place (they came on
+        its way, and wait) gets a step aside from there too, up to ``STEPS`` in all."""
         gap = now - self._asked_at > self.GAP_S
         self._asked_at = now
         pts = np.asarray(people, dtype=float).reshape(-1, 2)
