@@ -43,6 +43,7 @@ from numpy.typing import ArrayLike
 from pfctl.core.mapping.planning import GridPlanner
 from pfctl.core.mapping.regions import RegionMap
 from pfctl.core.mapping.walls import segment_distance
+from pfctl.core.robot import wrap_angle
 
 XY = tuple[float, float]
 Segment = tuple[XY, XY]
@@ -187,7 +188,7 @@ class GiveWay:
             return False
         if heading is not None and math.dist(here, y.stood) > self.ARRIVED:
             back = math.atan2(y.stood[1] - here[1], y.stood[0] - here[0])
-            if abs((back - heading + math.pi) % (2 * math.pi) - math.pi) > self.AHEAD:
+            if abs(wrap_angle(back - heading)) > self.AHEAD:
                 return False
         if len(people) == 0:
             return True
