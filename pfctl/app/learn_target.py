@@ -55,12 +55,16 @@ from pfctl.mission import Mission
 
 if TYPE_CHECKING:
     from pfctl.backends.pybullet.simulation import SimRobot
+    from pfctl.core.mapping.planning import GridPlanner
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff", ".webp", ".ppm", ".pgm")
 #: Frames read from a video at most (evenly spaced over it).
 MAX_VIDEO_FRAMES = 60
 #: Where the target is asked to stand, metres in front of the robot (sim).
 STAND_DISTANCE = 1.4
+#: How long (simulated s) the target waits for other people to walk off the spots in front of
+#: the robot (sim).
+SPOT_WAIT_S = 30.0
 #: A sim detection farther than this from that spot is someone else, metres.
 SPOT_RADIUS = 0.6
 #: Nodding period of the head between the face and the legs, seconds (sim).
@@ -88,19 +92,56 @@ class Learned:
 
 
 def stand_in_front(
-    robot: SimRobot, distance: float = STAND_DISTANCE, source: str = "mission"
+    robot: SimRobot,
+    distance: float = STAND_DISTANCE,
+    source: str = "mission",
+    wait_s: float = SPOT_WAIT_S,
 ) -> tuple[float, float, float]:
     """Hold the scenario's target ``distance`` metres from the robot, facing it, on the first free
     spot with a clear line of sight, searching from straight ahead outwards; return the spot
-    ``(x, y, bearing)`` with the bearing relative to the robot's heading. UserError when the
-    scenario has no target or no spot is free."""
+    ``(x, y, bearing)`` with the bearing relative to the robot's heading.
+
+    Where other people stand on every such spot (the simulator may start one of them where the
+    target starts), the simulation runs on, the robot standing still and the target waiting
+    where she is, for up to ``wait_s`` seconds until one of them walks off a spot, as a
+    bystander in front of a real robot would be asked to. UserError when the scenario has no
+    target, or no spot is free (walls everywhere, or people on the free spots all that while).
+    """
     target = next((w for w in robot.people if w.is_target), None)
     if target is None:
         raise UserError(f"{source}: scenario.target: the mission names no target to learn")
     from pfctl.backends.pybullet.walkers import PERSON_RADIUS
 
     planner = robot.planner.with_radius(PERSON_RADIUS)
-    pose = robot.pose
+    start = robot.time
+    while True:
+        spots = _spots_in_front(robot.pose, planner, distance)
+        others = [w for w in robot.people if w is not target]
+        for spot, bearing in spots:
+            if all(math.hypot(w.x - spot.x, w.y - spot.y) >= 2 * PERSON_RADIUS for w in others):
+                target.hold(
+                    spot.x, spot.y, math.atan2(robot.pose.y - spot.y, robot.pose.x - spot.x)
+                )
+                return spot.x, spot.y, bearing
+        waited = robot.time - start
+        if not spots:
+            raise UserError(f"{source}: no free spot {distance:g} m around the robot's start")
+        if waited >= wait_s:
+            raise UserError(
+                f"{source}: no free spot {distance:g} m around the robot's start: other people "
+                f"stood on the free ones for {waited:.0f} s"
+            )
+        target.hold(target.x, target.y, target.theta)
+        robot.step()
+
+
+def _spots_in_front(
+    pose: Pose2D, planner: GridPlanner, distance: float
+) -> list[tuple[Pose2D, float]]:
+    """The spots ``distance`` m from ``pose`` free of walls and furniture with a clear line of
+    sight to it, each with its bearing from the heading, straight ahead first, then outwards
+    by 0.25 rad to either side."""
+    spots = []
     for k in range(25):
         bearing = (k + 1) // 2 * (0.25 if k % 2 else -0.25)
         if abs(bearing) > math.pi:
@@ -112,12 +153,8 @@ def stand_in_front(
         line = np.linspace([pose.x, pose.y], xy, 20)
         if np.min(planner.clearance_at(line)) <= 0.05:
             continue
-        others = [w for w in robot.people if w is not target]
-        if any(math.hypot(w.x - spot.x, w.y - spot.y) < 2 * PERSON_RADIUS for w in others):
-            continue
-        target.hold(spot.x, spot.y, math.atan2(pose.y - spot.y, pose.x - spot.x))
-        return spot.x, spot.y, bearing
-    raise UserError(f"{source}: no free spot {distance:g} m around the robot's start")
+        spots.append((spot, bearing))
+    return spots
 
 
 def learn_in_sim(
@@ -385,6 +422,7 @@ def learn_from_images(
 
 __all__ = [
     "MAX_VIDEO_FRAMES",
+    "SPOT_WAIT_S",
     "STAND_DISTANCE",
     "SWAY",
     "Learned",
