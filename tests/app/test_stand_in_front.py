@@ -43,7 +43,8 @@ def _others_off(robot: SimRobot, x: float, y: float) -> float:
 
 
 def test_the_target_waits_for_a_bystander_to_walk_off_the_spot_in_front() -> None:
-    mission = loads_mission(CORRIDOR.format(route="[[2.4, 3.0], [8.5, 3.0]]"), source="corridor.yaml")
+    walks_off = CORRIDOR.format(route="[[2.4, 3.0], [8.5, 3.0]]")
+    mission = loads_mission(walks_off, source="corridor.yaml")
     with SimRobot(sim_config(mission)) as robot:
         assert _others_off(robot, 1.0 + STAND_DISTANCE, 3.0) < 2 * PERSON_RADIUS
         x, y, bearing = stand_in_front(robot, source="corridor.yaml")
@@ -68,7 +69,8 @@ def test_the_generated_home_whose_look_alike_starts_on_the_target_learns_her() -
     """Home 8 of the look-alike homes (`pfctl mission generate --seed 8 --look-alikes 2`): Bob,
     a look-alike, starts 0.15 m from her, on every free spot in front of the robot; `pfctl
     bench` failed there before the target waited for him."""
-    mission = loads_mission(make_home(HomeOptions(seed=8, look_alikes=2)).text, source="home-08.yaml")
+    home = make_home(HomeOptions(seed=8, look_alikes=2)).text
+    mission = loads_mission(home, source="home-08.yaml")
     with SimRobot(sim_config(mission, 1)) as robot:
         x, y, _ = stand_in_front(robot, source="home-08.yaml")
         assert robot.time > 0.0
