@@ -113,19 +113,18 @@ def stand_in_front(
     from pfctl.backends.pybullet.walkers import PERSON_RADIUS
 
     planner = robot.planner.with_radius(PERSON_RADIUS)
+    pose = robot.pose  # the robot stands still while she waits: the spots stay the same
+    spots = _spots_in_front(pose, planner, distance)
+    if not spots:
+        raise UserError(f"{source}: no free spot {distance:g} m around the robot's start")
+    others = [w for w in robot.people if w is not target]
     start = robot.time
     while True:
-        spots = _spots_in_front(robot.pose, planner, distance)
-        others = [w for w in robot.people if w is not target]
         for spot, bearing in spots:
             if all(math.hypot(w.x - spot.x, w.y - spot.y) >= 2 * PERSON_RADIUS for w in others):
-                target.hold(
-                    spot.x, spot.y, math.atan2(robot.pose.y - spot.y, robot.pose.x - spot.x)
-                )
+                target.hold(spot.x, spot.y, math.atan2(pose.y - spot.y, pose.x - spot.x))
                 return spot.x, spot.y, bearing
         waited = robot.time - start
-        if not spots:
-            raise UserError(f"{source}: no free spot {distance:g} m around the robot's start")
         if waited >= wait_s:
             raise UserError(
                 f"{source}: no free spot {distance:g} m around the robot's start: other people "
